@@ -1,0 +1,25 @@
+#pragma once
+
+#include <string>
+
+#include "core/io/drive.h"
+#include "core/types/status.h"
+
+namespace stcalib::cli {
+
+// Exit codes shared by every subcommand.
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;  ///< bad input, unreadable data, or a negative result
+constexpr int kExitUsage = 2;    ///< unknown subcommand, missing or invalid flag
+
+int RunInfo();
+int RunProject();
+
+// Prints "stcalib <command>: error: <message>" to stderr and returns kExitFailure.
+int ReportError(const std::string& command, const Status& status);
+// Prints a usage error and returns kExitUsage.
+int UsageError(const std::string& command, const std::string& message);
+// Opens --drive with --calib_dir.
+Status OpenDriveFromFlags(Drive* drive);
+
+}  // namespace stcalib::cli

@@ -1,0 +1,86 @@
+// stcalib: targetless, online LiDAR–camera calibration of rotation, translation and time offset.
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
+#include "apps/commands.h"
+#include "apps/flags.h"
+
+namespace stcalib::cli {
+namespace {
+
+struct Subcommand {
+  const char* name;
+  const char* synopsis;
+  const char* summary;
+  int (*run)();
+};
+
+const std::vector<Subcommand>& Subcommands() {
+  static const std::vector<Subcommand> kSubcommands = {
+      {"info", "--drive=DRIVE_DIR [--calib_dir=DIR]",
+       "frames, sensor rates, stamp gaps, points per frame and the calibration of a drive",
+       &RunInfo},
+      {"project", "--drive=DRIVE_DIR --frame=I --out=FILE.png [--calib_dir=DIR]",
+       "LiDAR points of one frame projected on its image, coloured by depth", &RunProject},
+  };
+  return kSubcommands;
+}
+
+void PrintUsage(std::ostream& out) {
+  out << "stcalib: targetless online LiDAR-camera calibration (rotation, translation, time "
+         "offset)\n\nUsage: stcalib <subcommand> [--flags]\n\nSubcommands:\n";
+  for (const Subcommand& s : Subcommands()) {
+    out << "  " << s.name << " " << s.synopsis << "\n      " << s.summary << "\n";
+  }
+  out << "\nExit codes: 0 success, 1 failure (bad input or negative result), 2 usage error.\n"
+         "`stcalib <subcommand> --helpfull` lists every flag with its default.\n";
+}
+
+}  // namespace
+
+int Main(int argc, char** argv) {
+  if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
+      std::strcmp(argv[1], "help") == 0) {
+    PrintUsage(argc < 2 ? std::cerr : std::cout);
+    return argc < 2 ? kExitUsage : kExitOk;
+  }
+  const std::string name = argv[1];
+  const Subcommand* command = nullptr;
+  for (const Subcommand& s : Subcommands()) {
+    if (name == s.name) command = &s;
+  }
+  if (command == nullptr) {
+    std::cerr << "stcalib: unknown subcommand '" << name << "'\n\n";
+    PrintUsage(std::cerr);
+    return kExitUsage;
+  }
+  for (int i = 2; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
+      std::cout << "Usage: stcalib " << command->name << " " << command->synopsis << "\n  "
+                << command->summary << "\n";
+      return kExitOk;
+    }
+  }
+  // Drop the subcommand so that gflags sees only flags.
+  std::vector<char*> args(argv, argv + argc);
+  args.erase(args.begin() + 1);
+  int args_count = static_cast<int>(args.size());
+  char** args_data = args.data();
+  gflags::SetUsageMessage(std::string("stcalib ") + command->name + " " + command->synopsis);
+  gflags::ParseCommandLineFlags(&args_count, &args_data, /*remove_flags=*/true);
+  if (args_count > 1) {
+    return UsageError(command->name, std::string("unexpected argument '") + args_data[1] + "'");
+  }
+  FLAGS_logtostderr = true;
+  google::InitGoogleLogging(argv[0]);
+  return command->run();
+}
+
+}  // namespace stcalib::cli
+
+int main(int argc, char** argv) { return stcalib::cli::Main(argc, argv); }

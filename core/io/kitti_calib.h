@@ -1,0 +1,68 @@
+#pragma once
+
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/types/status.h"
+#include "core/types/transform.h"
+
+namespace stcalib {
+
+// A KITTI calibration text file: lines "key: values". Numeric keys keep every number; text keys
+// (calib_time) keep their text. Entry order is kept so that a file can be written back as read.
+class KittiCalibFile {
+ public:
+  static Status Read(const std::string& path, KittiCalibFile* file);
+  Status Write(const std::string& path) const;
+
+  bool Has(const std::string& key) const { return numbers_.count(key) > 0; }
+  // Fetches a numeric key holding exactly rows*cols numbers (row-major); errors name the file,
+  // the key and, when present, its line.
+  Status GetMatrix(const std::string& key, int rows, int cols, Eigen::MatrixXd* matrix) const;
+  const std::map<std::string, std::vector<double>>& numbers() const { return numbers_; }
+  const std::vector<std::string>& keys() const { return order_; }
+  std::string Text(const std::string& key) const;
+
+  void SetNumbers(const std::string& key, const std::vector<double>& values);
+  void SetText(const std::string& key, const std::string& text);
+  void SetMatrix(const std::string& key, const Eigen::MatrixXd& matrix);  // row-major
+  const std::string& path() const { return path_; }
+
+ private:
+  void AddKey(const std::string& key);
+
+  std::string path_;
+  std::vector<std::string> order_;
+  std::map<std::string, std::vector<double>> numbers_;
+  std::map<std::string, std::string> texts_;
+  std::map<std::string, int> lines_;
+};
+
+// calib_cam_to_cam.txt: the rectification and projection of the colour camera image_02.
+struct CameraCalibration {
+  Eigen::Matrix3d R_rect_00 = Eigen::Matrix3d::Identity();
+  Eigen::Matrix<double, 3, 4> P_rect_02 = Eigen::Matrix<double, 3, 4>::Zero();
+  int image_width = 0;   ///< from S_rect_02 [px]
+  int image_height = 0;  ///< from S_rect_02 [px]
+  KittiCalibFile file;   ///< every key of the file
+};
+
+Status ReadCamToCam(const std::string& path, CameraCalibration* calibration);
+
+// calib_velo_to_cam.txt: R (9) and T (3) of T_camera_lidar (LiDAR to unrectified camera 0).
+Status ReadVeloToCam(const std::string& path, Rigid3d* T_camera_lidar);
+// Writes R, T (and KITTI's delta_f / delta_c, zero) with 12 significant digits.
+Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar);
+
+// calib_imu_to_velo.txt: R (9) and T (3) of T_lidar_imu.
+Status ReadImuToVelo(const std::string& path, Rigid3d* T_lidar_imu);
+Status WriteImuToVelo(const std::string& path, const Rigid3d& T_lidar_imu);
+
+// Checks that a 3x3 matrix read from `what` is a rotation (orthonormal, det +1, to 1e-3).
+Status CheckRotation(const Eigen::Matrix3d& rotation, const std::string& what);
+
+}  // namespace stcalib
