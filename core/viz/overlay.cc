@@ -23,8 +23,7 @@ cv::Mat RenderDepthOverlay(const cv::Mat& image_bgr, const std::vector<Projected
   cv::Mat colours;
   cv::applyColorMap(ramp, colours, cv::COLORMAP_JET);
 
-  const double inv_near = 1.0 / options.min_depth_m;
-  const double inv_far = 1.0 / options.max_depth_m;
+  const double log_range = std::log(options.max_depth_m / options.min_depth_m);
   // Far points first so near ones stay on top.
   std::vector<const ProjectedPoint*> order;
   order.reserve(points.size());
@@ -32,8 +31,8 @@ cv::Mat RenderDepthOverlay(const cv::Mat& image_bgr, const std::vector<Projected
   std::sort(order.begin(), order.end(),
             [](const ProjectedPoint* a, const ProjectedPoint* b) { return a->depth_m > b->depth_m; });
   for (const ProjectedPoint* p : order) {
-    const double inv = 1.0 / std::max(p->depth_m, 1e-3);
-    const double s = std::clamp((inv - inv_far) / (inv_near - inv_far), 0.0, 1.0);
+    const double s = std::clamp(
+        std::log(options.max_depth_m / std::max(p->depth_m, 1e-3)) / log_range, 0.0, 1.0);
     const cv::Vec3b c = colours.at<cv::Vec3b>(0, static_cast<int>(std::lround(s * 255.0)));
     cv::circle(canvas, cv::Point(static_cast<int>(std::lround(p->pixel.x())),
                                  static_cast<int>(std::lround(p->pixel.y()))),

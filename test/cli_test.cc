@@ -1,0 +1,92 @@
+// The stcalib binary end to end: exit codes and messages of info and project.
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <sys/wait.h>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/io/image.h"
+#include "test/test_util.h"
+
+namespace stcalib {
+namespace {
+
+using ::testing::HasSubstr;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+RunResult RunStcalib(const std::string& args) {
+  RunResult result;
+  const std::string command = std::string(STCALIB_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return result;
+}
+
+TEST(Cli, HelpListsSubcommands) {
+  const RunResult r = RunStcalib("--help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("info"));
+  EXPECT_THAT(r.output, HasSubstr("project"));
+  EXPECT_EQ(RunStcalib("").exit_code, 2);
+  const RunResult unknown = RunStcalib("frobnicate");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_THAT(unknown.output, HasSubstr("unknown subcommand 'frobnicate'"));
+}
+
+TEST(Cli, InfoAndProjectOnKitti) {
+  STCALIB_REQUIRE_KITTI();
+  const RunResult info = RunStcalib("info --drive=" + testing::KittiDriveDir());
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_THAT(info.output, HasSubstr("frames       30"));
+  EXPECT_THAT(info.output, HasSubstr("1242x375"));
+  testing::ScopedTempDir tmp;
+  const std::string png = tmp.path() + "/overlay.png";
+  const RunResult project = RunStcalib("project --drive=" + testing::KittiDriveDir() +
+                                " --frame=3 --out=" + png);
+  ASSERT_EQ(project.exit_code, 0) << project.output;
+  cv::Mat overlay;
+  ASSERT_TRUE(ReadImage(png, &overlay).ok());
+  EXPECT_EQ(overlay.cols, 1242);
+  EXPECT_EQ(overlay.rows, 375);
+}
+
+TEST(Cli, BadInputExitsNonZeroNamingTheFile) {
+  testing::ScopedTempDir tmp;
+  const RunResult missing = RunStcalib("info --drive=" + tmp.path() + "/absent");
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_THAT(missing.output, HasSubstr(tmp.path() + "/absent"));
+
+  const std::string drive = testing::MakeTinyDrive(tmp.path(), 2);
+  const std::string bin = drive + "/velodyne_points/data/0000000001.bin";
+  std::filesystem::resize_file(bin, 33);
+  const RunResult truncated = RunStcalib("info --drive=" + drive);
+  EXPECT_EQ(truncated.exit_code, 1);
+  EXPECT_THAT(truncated.output, HasSubstr(bin));
+  EXPECT_THAT(truncated.output, HasSubstr("truncated"));
+
+  const RunResult no_out = RunStcalib("project --drive=" + drive + " --frame=0");
+  EXPECT_EQ(no_out.exit_code, 2);
+  const RunResult out_of_range =
+      RunStcalib("project --drive=" + drive + " --frame=5 --out=" + tmp.path() + "/x.png");
+  EXPECT_EQ(out_of_range.exit_code, 1);
+  EXPECT_THAT(out_of_range.output, HasSubstr("frame 5 out of range"));
+  const RunResult unwritable =
+      RunStcalib("project --drive=" + drive + " --frame=0 --out=" + tmp.path() + "/no/such/dir/x.png");
+  EXPECT_EQ(unwritable.exit_code, 1);
+  EXPECT_THAT(unwritable.output, HasSubstr("no/such/dir/x.png"));
+}
+
+}  // namespace
+}  // namespace stcalib

@@ -1,0 +1,57 @@
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/io/drive.h"
+
+namespace stcalib::testing {
+
+// ../shared/data, configured by CMake. Tests that need it skip only when it is absent.
+inline std::string SharedDataDir() { return STCALIB_SHARED_DATA_DIR; }
+inline std::string KittiCalibDir() { return SharedDataDir() + "/kitti/2011_09_26"; }
+inline std::string KittiDriveDir() { return KittiCalibDir() + "/2011_09_26_drive_0013_sync"; }
+inline bool HaveKitti() { return std::filesystem::is_directory(KittiDriveDir()); }
+
+#define STCALIB_REQUIRE_KITTI()                                                              \
+  if (!::stcalib::testing::HaveKitti()) {                                                    \
+    GTEST_SKIP() << "shared KITTI data not found at " << ::stcalib::testing::KittiDriveDir() \
+                 << " (clone with ../shared beside the repository)";                        \
+  }
+
+// A fresh folder under the system temp dir, removed on destruction.
+class ScopedTempDir {
+ public:
+  ScopedTempDir() {
+    std::random_device rd;
+    path_ = (std::filesystem::temp_directory_path() /
+             ("stcalib_test_" + std::to_string(rd()) + std::to_string(rd())))
+                .string();
+    std::filesystem::create_directories(path_);
+  }
+  ~ScopedTempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+inline void WriteFile(const std::string& path, const std::string& contents) {
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << contents;
+}
+
+// Writes a small, valid KITTI-layout drive (calibration copied from fixed KITTI-like values)
+// into root/2011_01_01/2011_01_01_drive_0001_sync and returns the drive folder.
+std::string MakeTinyDrive(const std::string& root, int num_frames);
+
+}  // namespace stcalib::testing
