@@ -6,3 +6,10 @@ DEFINE_string(calib_dir, "",
               "(default: the drive's parent folder)");
 DEFINE_int32(frame, 0, "frame index (0-based, in file-name order)");
 DEFINE_string(out, "", "output file or folder");
+DEFINE_int32(frames, 40, "simulate: number of frames");
+DEFINE_uint64(seed, 1, "random seed (simulate: the whole drive)");
+DEFINE_double(time_offset_s, 0.0,
+              "simulate: true time offset δ [s]; LiDAR stamps are the true time minus δ");
+DEFINE_int32(dynamic_objects, 6, "simulate: moving vehicles and pedestrians");
+DEFINE_string(scene, "urban", "simulate: urban | poles (vertical structures only) | open");
+DEFINE_double(lidar_hz, 10.0, "simulate: LiDAR spin rate = frame rate of every sensor [Hz]");

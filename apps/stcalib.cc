@@ -27,6 +27,11 @@ const std::vector<Subcommand>& Subcommands() {
        &RunInfo},
       {"project", "--drive=DRIVE_DIR --frame=I --out=FILE.png [--calib_dir=DIR]",
        "LiDAR points of one frame projected on its image, coloured by depth", &RunProject},
+      {"simulate",
+       "--out=DIR [--frames=N (40)] [--seed=S (1)] [--time_offset_s=X (0)] "
+       "[--dynamic_objects=K (6)] [--scene=urban|poles|open] [--lidar_hz=10]",
+       "a KITTI-raw drive with exact ground truth (extrinsic, time offset, motion, labels)",
+       &RunSimulate},
   };
   return kSubcommands;
 }

@@ -1,0 +1,207 @@
+#include "core/sim/sensors.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stcalib::sim {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+constexpr double kGravity = 9.80665;
+constexpr double kEarthRadiusM = 6378137.0;
+
+uint8_t LabelOf(const Scene& scene, int object) {
+  if (object < 0) return static_cast<uint8_t>(PointLabel::kGround);
+  switch (scene.objects()[object].object_class) {
+    case ObjectClass::kGround: return static_cast<uint8_t>(PointLabel::kGround);
+    case ObjectClass::kMoving: return static_cast<uint8_t>(PointLabel::kDynamic);
+    case ObjectClass::kStructure: break;
+  }
+  return static_cast<uint8_t>(PointLabel::kStatic);
+}
+
+double TextureGain(const Material& m, const Eigen::Vector3d& p) {
+  switch (m.texture) {
+    case Texture::kPlain: return 1.0;
+    case Texture::kFoliage: return 0.35 + 1.0 * CellNoise(p, 0.07);
+    case Texture::kAsphalt: return 0.88 + 0.24 * CellNoise(p, 0.04);
+    case Texture::kFacade: return 0.95 + 0.1 * CellNoise(p, 0.25);
+  }
+  return 1.0;
+}
+
+}  // namespace
+
+double LidarModel::ElevationDeg(int beam) const {
+  const int half = beams / 2;
+  if (beam < half) {
+    return elevation_top_deg + (elevation_upper_bottom_deg - elevation_top_deg) * beam / (half - 1);
+  }
+  return elevation_lower_top_deg +
+         (elevation_bottom_deg - elevation_lower_top_deg) * (beam - half) / (beams - half - 1);
+}
+
+SimulatedSweep SimulateLidarSweep(const Scene& scene, const SimTrajectory& trajectory,
+                                  const Rigid3d& T_imu_lidar, const LidarModel& model,
+                                  double t_mid_s, double sweep_duration_s, std::mt19937_64* rng) {
+  const int columns = static_cast<int>(std::lround(360.0 / model.azimuth_step_deg));
+  // Column j in file order: azimuth from just left of ahead, counter-clockwise all the way round.
+  std::vector<double> azimuth(columns), time(columns);
+  std::vector<Rigid3d> T_world_lidar(columns);
+  for (int j = 0; j < columns; ++j) {
+    double a = (0.5 + j) * model.azimuth_step_deg * kDegToRad;
+    if (a > M_PI) a -= 2 * M_PI;
+    azimuth[j] = a;
+    time[j] = t_mid_s - a / (2 * M_PI) * sweep_duration_s;  // clockwise spin
+    T_world_lidar[j] = trajectory.T_world_imu(time[j]) * T_imu_lidar;
+  }
+  const Rigid3d T_mid = trajectory.T_world_imu(t_mid_s) * T_imu_lidar;
+  const double margin = SimTrajectory::kMaxSpeedMps * 0.5 * sweep_duration_s + 0.5;
+  const AzimuthIndex index =
+      scene.BuildIndex(T_mid.translation().head<2>(), t_mid_s - 0.5 * sweep_duration_s,
+                       t_mid_s + 0.5 * sweep_duration_s, margin, model.max_range_m);
+
+  std::normal_distribution<double> range_noise(0.0, model.range_noise_m);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  SimulatedSweep sweep;
+  const size_t reserve = static_cast<size_t>(columns) * model.beams * 3 / 5;
+  sweep.scan.points_lidar.reserve(reserve);
+  sweep.scan.reflectance.reserve(reserve);
+  sweep.labels.reserve(reserve);
+  sweep.point_time_s.reserve(reserve);
+  sweep.ring.reserve(reserve);
+  std::vector<double> cos_az(columns), sin_az(columns);
+  for (int j = 0; j < columns; ++j) {
+    cos_az[j] = std::cos(azimuth[j]);
+    sin_az[j] = std::sin(azimuth[j]);
+  }
+  for (int beam = 0; beam < model.beams; ++beam) {
+    const double el = model.ElevationDeg(beam) * kDegToRad;
+    const double ce = std::cos(el), se = std::sin(el);
+    for (int j = 0; j < columns; ++j) {
+      const Eigen::Vector3d dir_lidar(ce * cos_az[j], ce * sin_az[j], se);
+      const Eigen::Vector3d dir_world = T_world_lidar[j].linear() * dir_lidar;
+      RayHit hit;
+      if (!scene.Intersect(index, T_world_lidar[j].translation(), dir_world, time[j],
+                           model.max_range_m, &hit)) {
+        continue;
+      }
+      const Material& material = scene.materials()[hit.material];
+      double range = hit.range + range_noise(*rng);
+      if (material.texture == Texture::kFoliage) {
+        range += model.foliage_penetration_m * unit(*rng);
+      }
+      if (range < model.min_range_m || range > model.max_range_m) continue;
+      const double incidence = std::abs(hit.normal_world.dot(dir_world));
+      const double reflectance =
+          std::clamp(material.reflectance * (0.4 + 0.6 * incidence), 0.0, 1.0);
+      sweep.scan.points_lidar.push_back(dir_lidar * range);
+      sweep.scan.reflectance.push_back(static_cast<float>(std::round(reflectance * 100) / 100));
+      sweep.labels.push_back(LabelOf(scene, hit.object));
+      sweep.point_time_s.push_back(time[j]);
+      sweep.ring.push_back(static_cast<uint16_t>(beam));
+    }
+  }
+  return sweep;
+}
+
+cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory,
+                          const CameraRig& rig, double t_s, std::mt19937_64* rng) {
+  const Rigid3d T_world_camera = trajectory.T_world_imu(t_s) * rig.T_imu_camera;
+  const Eigen::Matrix3d K = rig.P_rect_02.leftCols<3>();
+  const Eigen::Matrix3d K_inv = K.inverse();
+  // Rectified camera 2 centre: P = K [I | K⁻¹ p4], so c_rect = −K⁻¹ p4.
+  const Eigen::Vector3d c_rect = -K_inv * rig.P_rect_02.col(3);
+  const Eigen::Matrix3d R_world_rect = T_world_camera.linear() * rig.R_rect_00.transpose();
+  const Eigen::Vector3d origin = T_world_camera * (rig.R_rect_00.transpose() * c_rect);
+  constexpr double kMaxRange = 400.0;
+  const AzimuthIndex index = scene.BuildIndex(origin.head<2>(), t_s, t_s, 0.5, kMaxRange);
+
+  const Eigen::Vector3d sky_top(0.85, 0.62, 0.42), sky_horizon(0.95, 0.88, 0.82);  // BGR
+  constexpr double kAmbient = 0.35, kDiffuse = 0.65;
+  std::normal_distribution<double> noise(0.0, rig.noise_sigma);
+  cv::Mat image(rig.height, rig.width, CV_8UC3);
+  for (int v = 0; v < rig.height; ++v) {
+    auto* row = image.ptr<cv::Vec3b>(v);
+    for (int u = 0; u < rig.width; ++u) {
+      const Eigen::Vector3d dir = (R_world_rect * (K_inv * Eigen::Vector3d(u, v, 1))).normalized();
+      Eigen::Vector3d colour;
+      RayHit hit;
+      if (scene.Intersect(index, origin, dir, t_s, kMaxRange, &hit)) {
+        const Material& m = scene.materials()[hit.material];
+        const double shade = kAmbient + kDiffuse * std::max(0.0, hit.normal_world.dot(rig.sun_world));
+        colour = m.albedo_bgr * (shade * TextureGain(m, hit.point_world));
+      } else {
+        const double k = std::clamp(dir.z() * 3.0, 0.0, 1.0);
+        colour = (1 - k) * sky_horizon + k * sky_top;
+      }
+      for (int c = 0; c < 3; ++c) {
+        row[u][c] = cv::saturate_cast<uint8_t>(255.0 * colour[c] + noise(*rng));
+      }
+    }
+  }
+  return image;
+}
+
+OxtsPacket SynthesizeOxtsPacket(const SimTrajectory& trajectory, const OxtsOrigin& origin,
+                                double t_s, std::mt19937_64* rng) {
+  constexpr double h = 1e-3;  // central differences [s]
+  const Rigid3d T0 = trajectory.T_world_imu(t_s - h);
+  const Rigid3d T1 = trajectory.T_world_imu(t_s);
+  const Rigid3d T2 = trajectory.T_world_imu(t_s + h);
+  const Eigen::Vector3d rpy = trajectory.RollPitchYaw(t_s);
+  const Eigen::Vector3d v_world = (T2.translation() - T0.translation()) / (2 * h);
+  const Eigen::Vector3d a_world =
+      (T2.translation() - 2 * T1.translation() + T0.translation()) / (h * h);
+  const Eigen::Vector3d w_body = LogSO3(T0.linear().transpose() * T2.linear()) / (2 * h);
+  const Eigen::Matrix3d R_heading =
+      Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d specific_force = a_world + Eigen::Vector3d(0, 0, kGravity);
+
+  std::normal_distribution<double> n_angle(0, 2e-4), n_vel(0, 0.02), n_acc(0, 0.05),
+      n_rate(0, 5e-4), n_pos(0, 0.01);
+  OxtsPacket p;
+  // Invert the Mercator projection of oxts_poses.h (scale of the origin latitude).
+  const double scale = std::cos(origin.lat_deg * M_PI / 180.0);
+  const double x0 = scale * kEarthRadiusM * origin.lon_deg * M_PI / 180.0;
+  const double y0 = scale * kEarthRadiusM * std::log(std::tan(M_PI * (90.0 + origin.lat_deg) / 360.0));
+  const double x = T1.translation().x() + n_pos(*rng) + x0;
+  const double y = T1.translation().y() + n_pos(*rng) + y0;
+  p.lon = x / (scale * kEarthRadiusM) * 180.0 / M_PI;
+  p.lat = 360.0 / M_PI * std::atan(std::exp(y / (scale * kEarthRadiusM))) - 90.0;
+  p.alt = origin.alt_m + T1.translation().z() + n_pos(*rng);
+  p.roll = rpy.x() + n_angle(*rng);
+  p.pitch = rpy.y() + n_angle(*rng);
+  p.yaw = std::remainder(rpy.z() + n_angle(*rng), 2 * M_PI);
+  p.vn = v_world.y() + n_vel(*rng);
+  p.ve = v_world.x() + n_vel(*rng);
+  const Eigen::Vector3d v_heading = R_heading.transpose() * v_world;
+  p.vf = v_heading.x() + n_vel(*rng);
+  p.vl = v_heading.y() + n_vel(*rng);
+  p.vu = v_heading.z() + n_vel(*rng);
+  const Eigen::Vector3d a_body = T1.linear().transpose() * specific_force;
+  p.ax = a_body.x() + n_acc(*rng);
+  p.ay = a_body.y() + n_acc(*rng);
+  p.az = a_body.z() + n_acc(*rng);
+  const Eigen::Vector3d a_heading = R_heading.transpose() * specific_force;
+  p.af = a_heading.x() + n_acc(*rng);
+  p.al = a_heading.y() + n_acc(*rng);
+  p.au = a_heading.z() + n_acc(*rng);
+  p.wx = w_body.x() + n_rate(*rng);
+  p.wy = w_body.y() + n_rate(*rng);
+  p.wz = w_body.z() + n_rate(*rng);
+  const Eigen::Vector3d w_heading = R_heading.transpose() * (T1.linear() * w_body);
+  p.wf = w_heading.x() + n_rate(*rng);
+  p.wl = w_heading.y() + n_rate(*rng);
+  p.wu = w_heading.z() + n_rate(*rng);
+  p.pos_accuracy = 0.05;
+  p.vel_accuracy = 0.02;
+  p.navstat = 4;
+  p.numsats = 9;
+  p.posmode = 4;
+  p.velmode = 4;
+  p.orimode = 4;
+  return p;
+}
+
+}  // namespace stcalib::sim

@@ -1,0 +1,95 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "core/io/kitti_calib.h"
+#include "core/io/timestamps.h"
+#include "core/motion/oxts_poses.h"
+#include "core/sim/road.h"
+#include "core/sim/scene.h"
+#include "core/sim/sensors.h"
+#include "core/sim/trajectory.h"
+#include "core/types/status.h"
+
+namespace stcalib::sim {
+
+struct SimulatorOptions {
+  int frames = 40;                 ///< frames to simulate (camera, LiDAR and oxts each)
+  uint64_t seed = 1;               ///< everything random derives from it
+  double time_offset_s = 0.0;      ///< δ: LiDAR stamps = true mid-sweep time − δ [s]
+  int dynamic_objects = 6;         ///< moving vehicles and pedestrians
+  SceneType scene = SceneType::kUrban;
+  double lidar_hz = 10.0;          ///< spin rate = frame rate of every sensor [Hz]
+  double camera_delay_s = 0.0105;  ///< camera exposure after the LiDAR faces forward [s]
+
+  Status Validate() const;
+};
+
+// True times and written stamps of one frame.
+struct FrameTiming {
+  double camera_time_s = 0;     ///< true capture time of the image (= its stamp) [s]
+  double lidar_mid_time_s = 0;  ///< true time the LiDAR faces forward [s]
+  double oxts_time_s = 0;       ///< true time of the oxts packet (= its stamp) [s]
+  StampNs camera_stamp_ns = 0, lidar_stamp_ns = 0, lidar_start_stamp_ns = 0,
+          lidar_end_stamp_ns = 0, oxts_stamp_ns = 0;
+};
+
+struct SimulatedFrame : FrameTiming {
+  SimulatedSweep sweep;
+  cv::Mat image_bgr;
+  OxtsPacket oxts;
+};
+
+// Ground truth and sensors of one simulated drive. Times are seconds from the drive's start
+// epoch (stamps add `start_stamp_ns`); the camera clock is the true clock.
+class Simulator {
+ public:
+  // `options` must be valid (call Validate() on user input first).
+  explicit Simulator(const SimulatorOptions& options);
+
+  SimulatedFrame SimulateFrame(int frame) const;
+  FrameTiming Timing(int frame) const;
+  OxtsPacket SimulateOxts(int frame) const;  ///< the packet of SimulateFrame(frame), alone
+
+  const SimulatorOptions& options() const { return options_; }
+  const Rigid3d& T_camera_lidar() const { return T_camera_lidar_; }
+  const Rigid3d& T_lidar_imu() const { return T_lidar_imu_; }
+  const CameraRig& camera_rig() const { return rig_; }
+  const LidarModel& lidar_model() const { return lidar_; }
+  const SimTrajectory& trajectory() const { return *trajectory_; }
+  const Scene& scene() const { return *scene_; }
+  const OxtsOrigin& oxts_origin() const { return origin_; }
+  StampNs start_stamp_ns() const { return start_stamp_ns_; }
+  double SweepDuration() const { return 1.0 / options_.lidar_hz; }
+  double LidarMidTime(int frame) const { return 0.05 + frame / options_.lidar_hz; }
+  // calib_cam_to_cam.txt contents (KITTI keys for image_02 and the rectification).
+  KittiCalibFile CameraCalibFile() const;
+  std::string DateFolder() const;  ///< e.g. "2026_01_02"
+
+ private:
+  SimulatorOptions options_;
+  std::unique_ptr<SimRoad> road_;
+  std::unique_ptr<SimTrajectory> trajectory_;
+  std::unique_ptr<Scene> scene_;
+  Rigid3d T_camera_lidar_, T_lidar_imu_;
+  CameraRig rig_;
+  LidarModel lidar_;
+  OxtsOrigin origin_;
+  StampNs start_stamp_ns_ = 0;
+};
+
+// Writes a drive in KITTI raw layout (method.md §9) under out_dir/<date>/: the three calibration
+// files, ground_truth.json, and <date>_drive_0001_sync/ with image_02, velodyne_points (+ labels)
+// and oxts. Everything goes to a hidden temporary folder first and is renamed into place at the
+// end, so an interrupted run never leaves a drive that looks complete. `progress` (optional) is
+// called after each frame.
+Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& out_dir,
+                           std::string* drive_dir,
+                           const std::function<void(int done, int total)>& progress = nullptr);
+
+}  // namespace stcalib::sim

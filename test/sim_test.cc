@@ -1,0 +1,330 @@
+// The simulator against its own ground truth: geometry (LiDAR edges on image edges), motion
+// (oxts integrates to the true poses), I/O (KITTI reader round trip), determinism and labels.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/io/drive.h"
+#include "core/io/image.h"
+#include "core/motion/oxts_poses.h"
+#include "core/score/projection.h"
+#include "core/sim/simulator.h"
+#include "core/types/calibration.h"
+#include "test/test_util.h"
+
+namespace stcalib::sim {
+namespace {
+
+using stcalib::testing::ScopedTempDir;
+
+SimulatorOptions SmallOptions(uint64_t seed, int frames) {
+  SimulatorOptions options;
+  options.seed = seed;
+  options.frames = frames;
+  options.time_offset_s = 0.03;
+  return options;
+}
+
+Rigid3d TWorldLidar(const Simulator& sim, double t) {
+  return sim.trajectory().T_world_imu(t) * sim.T_lidar_imu().inverse();
+}
+
+// Depth-discontinuity points (near side) of static structure, walking each ring in azimuth.
+std::vector<int> StaticEdgePoints(const SimulatedSweep& sweep, double azimuth_step_rad) {
+  std::vector<int> edges;
+  const auto& p = sweep.scan.points_lidar;
+  for (size_t i = 0; i + 1 < p.size(); ++i) {
+    if (sweep.ring[i] != sweep.ring[i + 1]) continue;
+    const double da = std::remainder(std::atan2(p[i + 1].y(), p[i + 1].x()) -
+                                         std::atan2(p[i].y(), p[i].x()),
+                                     2 * M_PI);
+    if (std::abs(da) > 1.5 * azimuth_step_rad) continue;
+    const double ri = p[i].norm(), rj = p[i + 1].norm();
+    if (std::abs(ri - rj) < std::max(0.5, 0.05 * std::min(ri, rj))) continue;
+    const int near = ri < rj ? static_cast<int>(i) : static_cast<int>(i + 1);
+    if (sweep.labels[near] == static_cast<uint8_t>(PointLabel::kStatic)) edges.push_back(near);
+  }
+  return edges;
+}
+
+struct EdgeDistance {
+  double median_px = 1e9;  ///< median distance to the nearest Canny edge [px]
+  double within_1_5px = 0;  ///< share of points within 1.5 px of an edge
+  size_t count = 0;
+};
+
+// Distances from projected, motion-compensated LiDAR edge points to Canny edges.
+EdgeDistance MeasureEdgeDistance(const Simulator& sim, const SimulatedFrame& f,
+                                 const Rigid3d& T_camera_lidar) {
+  const std::vector<int> edges =
+      StaticEdgePoints(f.sweep, sim.lidar_model().azimuth_step_deg * M_PI / 180.0);
+  const Rigid3d T_lidar_at_camera_inv = TWorldLidar(sim, f.camera_time_s).inverse();
+  std::vector<Eigen::Vector3d> points;
+  for (int i : edges) {
+    // Each point moves from its own capture time to the image time.
+    points.push_back(T_lidar_at_camera_inv * TWorldLidar(sim, f.sweep.point_time_s[i]) *
+                     f.sweep.scan.points_lidar[i]);
+  }
+  CameraModel camera;
+  camera.R_rect_00 = sim.camera_rig().R_rect_00;
+  camera.P_rect_02 = sim.camera_rig().P_rect_02;
+  camera.width = f.image_bgr.cols;
+  camera.height = f.image_bgr.rows;
+  const std::vector<ProjectedPoint> projected = ProjectPoints(camera, T_camera_lidar, points);
+  cv::Mat gray, canny, distance;
+  cv::cvtColor(f.image_bgr, gray, cv::COLOR_BGR2GRAY);
+  cv::Canny(gray, canny, 40, 120);
+  cv::distanceTransform(255 - canny, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  std::vector<double> d;
+  for (const ProjectedPoint& p : projected) {
+    d.push_back(distance.at<float>(static_cast<int>(std::lround(p.pixel.y())),
+                                   static_cast<int>(std::lround(p.pixel.x()))));
+  }
+  EdgeDistance result;
+  result.count = d.size();
+  if (d.empty()) return result;
+  result.within_1_5px =
+      std::count_if(d.begin(), d.end(), [](double x) { return x <= 1.5; }) / double(d.size());
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  result.median_px = d[d.size() / 2];
+  return result;
+}
+
+TEST(Simulator, LidarEdgesLieOnImageEdgesWithTruth) {
+  for (uint64_t seed : {3u, 11u}) {
+    const Simulator sim(SmallOptions(seed, 30));
+    for (int frame : {0, 25}) {
+      const SimulatedFrame f = sim.SimulateFrame(frame);
+      const EdgeDistance truth = MeasureEdgeDistance(sim, f, sim.T_camera_lidar());
+      EXPECT_GT(truth.count, 200u) << "seed " << seed << " frame " << frame;
+      EXPECT_LE(truth.median_px, 1.5) << "seed " << seed << " frame " << frame;
+      // The same measure sees a 1° error: the check can fail.
+      const Rigid3d wrong = PerturbTcameraLidar(sim.T_camera_lidar(), Eigen::Vector3d(0, 0.7, 0.7),
+                                                Eigen::Vector3d::Zero());
+      const EdgeDistance off = MeasureEdgeDistance(sim, f, wrong);
+      EXPECT_LT(off.within_1_5px, truth.within_1_5px - 0.15) << "seed " << seed << " frame " << frame;
+      std::printf("seed %llu frame %d: median %.2f px, %.0f%% within 1.5 px (truth); "
+                  "median %.2f px, %.0f%% (1 deg off)\n",
+                  static_cast<unsigned long long>(seed), frame, truth.median_px,
+                  100 * truth.within_1_5px, off.median_px, 100 * off.within_1_5px);
+    }
+  }
+}
+
+TEST(Simulator, OxtsIntegratesToTheTruePoses) {
+  for (uint64_t seed : {1u, 2u, 5u}) {
+    const Simulator sim(SmallOptions(seed, 40));
+    std::vector<OxtsPacket> packets;
+    std::vector<double> stamps_s;
+    std::vector<Rigid3d> truth;
+    for (int i = 0; i < 40; ++i) {
+      packets.push_back(sim.SimulateOxts(i));
+      stamps_s.push_back(sim.Timing(i).oxts_time_s);
+      truth.push_back(sim.trajectory().T_world_imu(stamps_s.back()));
+    }
+    double path_length = 0;
+    for (size_t i = 1; i < truth.size(); ++i) {
+      path_length += (truth[i].translation() - truth[i - 1].translation()).norm();
+    }
+    EXPECT_GT(path_length, 0.39 * 8.0 * 3.9);  // ≥ 8 m/s over 3.9 s
+    const std::vector<Eigen::Vector3d> integrated =
+        IntegrateOxtsVelocities(packets, stamps_s, truth[0].translation());
+    double yaw_from_rates = packets[0].yaw, speed_from_accel = packets[0].vf;
+    for (size_t i = 0; i < truth.size(); ++i) {
+      EXPECT_LT((integrated[i] - truth[i].translation()).norm(), 0.005 * path_length)
+          << "seed " << seed << " frame " << i;
+      // GPS/INS poses (Mercator, attitude) agree with the truth.
+      const Rigid3d pose = OxtsPose(sim.oxts_origin(), packets[i]);
+      EXPECT_LT((pose.translation() - truth[i].translation()).norm(), 0.06);
+      EXPECT_LT(RotationErrorDeg(pose.linear(), truth[i].linear()), 0.05);
+      if (i > 0) {
+        // Heading rate wu integrates to the heading; forward acceleration to the speed change.
+        const double dt = stamps_s[i] - stamps_s[i - 1];
+        yaw_from_rates += 0.5 * dt * (packets[i - 1].wu + packets[i].wu);
+        EXPECT_NEAR(std::remainder(yaw_from_rates - packets[i].yaw, 2 * M_PI), 0.0, 2e-3);
+        speed_from_accel += 0.5 * dt * (packets[i - 1].af + packets[i].af);
+        EXPECT_NEAR(speed_from_accel, packets[i].vf, 0.15);
+      }
+      EXPECT_NEAR(packets[i].az, 9.80665, 0.5);  // specific force includes gravity
+    }
+  }
+}
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(Simulator, DriveRoundTripsThroughTheKittiReader) {
+  ScopedTempDir tmp;
+  const SimulatorOptions options = SmallOptions(7, 3);
+  std::string drive_dir;
+  const Status status = WriteSimulatedDrive(options, tmp.path(), &drive_dir);
+  ASSERT_TRUE(status.ok()) << status.message();
+  Drive drive;
+  const Status open = OpenDrive(drive_dir, "", &drive);
+  ASSERT_TRUE(open.ok()) << open.message();
+  const Simulator sim(options);
+  ASSERT_EQ(drive.NumFrames(), 3u);
+  EXPECT_TRUE(drive.has_oxts);
+  EXPECT_LT((drive.T_camera_lidar.matrix() - sim.T_camera_lidar().matrix()).cwiseAbs().maxCoeff(),
+            1e-11);
+  EXPECT_LT((drive.T_lidar_imu.matrix() - sim.T_lidar_imu().matrix()).cwiseAbs().maxCoeff(), 1e-11);
+  EXPECT_EQ(drive.camera.image_width, 1242);
+  EXPECT_LT((drive.camera.P_rect_02 - sim.camera_rig().P_rect_02).cwiseAbs().maxCoeff(), 1e-9);
+  for (int i = 0; i < 3; ++i) {
+    const SimulatedFrame f = sim.SimulateFrame(i);
+    EXPECT_EQ(drive.camera_stamps_ns[i], f.camera_stamp_ns);
+    EXPECT_EQ(drive.lidar_stamps_ns[i], f.lidar_stamp_ns);
+    EXPECT_EQ(drive.lidar_start_stamps_ns[i], f.lidar_start_stamp_ns);
+    EXPECT_EQ(drive.oxts_stamps_ns[i], f.oxts_stamp_ns);
+    // δ: the LiDAR stamp plus the offset is the true mid-sweep time.
+    EXPECT_NEAR(NsToSeconds(drive.lidar_stamps_ns[i] - sim.start_stamp_ns()) + 0.03,
+                f.lidar_mid_time_s, 1e-9);
+    LidarScan scan;
+    ASSERT_TRUE(drive.LoadScan(i, &scan).ok());
+    ASSERT_EQ(scan.size(), f.sweep.scan.size());
+    for (size_t k = 0; k < scan.size(); k += 97) {
+      EXPECT_LT((scan.points_lidar[k] - f.sweep.scan.points_lidar[k]).norm(), 1e-5);
+    }
+    std::vector<uint8_t> labels;
+    ASSERT_TRUE(ReadPointLabels(drive.LabelsPath(i), &labels).ok());
+    EXPECT_EQ(labels, f.sweep.labels);
+    cv::Mat image;
+    ASSERT_TRUE(drive.LoadImage(i, &image).ok());
+    EXPECT_EQ(cv::norm(image, f.image_bgr, cv::NORM_INF), 0.0);
+    EXPECT_EQ(FormatOxtsPacket(drive.oxts[i]), FormatOxtsPacket(f.oxts));
+  }
+  const nlohmann::json truth =
+      nlohmann::json::parse(Slurp(drive.calib_dir + "/ground_truth.json"));
+  EXPECT_DOUBLE_EQ(truth["time_offset_s"].get<double>(), 0.03);
+  ASSERT_EQ(truth["T_camera_lidar"].size(), 16u);
+  for (int k = 0; k < 16; ++k) {
+    EXPECT_DOUBLE_EQ(truth["T_camera_lidar"][k].get<double>(),
+                     sim.T_camera_lidar().matrix()(k / 4, k % 4));
+  }
+  EXPECT_EQ(truth["per_frame"].size(), 3u);
+  // Nothing but the finished drive is left in the output folder.
+  int entries = 0;
+  for (const auto& e : std::filesystem::directory_iterator(tmp.path())) {
+    ++entries;
+    EXPECT_EQ(e.path().filename().string(), sim.DateFolder());
+  }
+  EXPECT_EQ(entries, 1);
+}
+
+std::map<std::string, std::string> ReadTree(const std::string& root) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(root)) {
+    if (e.is_regular_file()) {
+      files[std::filesystem::relative(e.path(), root).string()] = Slurp(e.path().string());
+    }
+  }
+  return files;
+}
+
+TEST(Simulator, SameSeedWritesIdenticalFiles) {
+  ScopedTempDir a, b, c;
+  std::string drive;
+  ASSERT_TRUE(WriteSimulatedDrive(SmallOptions(5, 2), a.path(), &drive).ok());
+  ASSERT_TRUE(WriteSimulatedDrive(SmallOptions(5, 2), b.path(), &drive).ok());
+  ASSERT_TRUE(WriteSimulatedDrive(SmallOptions(6, 2), c.path(), &drive).ok());
+  const auto files_a = ReadTree(a.path()), files_b = ReadTree(b.path()), files_c = ReadTree(c.path());
+  EXPECT_GT(files_a.size(), 15u);
+  EXPECT_TRUE(files_a == files_b);
+  EXPECT_FALSE(files_a == files_c);
+}
+
+// Distance from a world point to a moving object's shapes at time t.
+double DistanceToObject(const Scene& scene, int object, const Eigen::Vector3d& p_world, double t) {
+  const Pose2 pose = scene.ObjectPose(object, t);
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  const Eigen::Vector3d rel = p_world - Eigen::Vector3d(pose.position.x(), pose.position.y(), 0);
+  const Eigen::Vector3d p(c * rel.x() + s * rel.y(), -s * rel.x() + c * rel.y(), rel.z());
+  double best = 1e9;
+  for (const Shape& shape : scene.objects()[object].shapes) {
+    if (shape.kind == Shape::Kind::kBox) {
+      const Eigen::Vector3d outside = (shape.a - p).cwiseMax(p - shape.b).cwiseMax(0.0);
+      best = std::min(best, outside.norm());
+    } else if (shape.kind == Shape::Kind::kSphere) {
+      best = std::min(best, std::max(0.0, (p - shape.a).norm() - shape.b.x()));
+    }
+  }
+  return best;
+}
+
+TEST(Simulator, DynamicLabelsMarkExactlyThePointsOnMovingObjects) {
+  const Simulator sim(SmallOptions(4, 10));
+  const Scene& scene = sim.scene();
+  std::vector<int> moving;
+  for (int i = 0; i < static_cast<int>(scene.objects().size()); ++i) {
+    if (scene.objects()[i].moving) moving.push_back(i);
+  }
+  ASSERT_EQ(moving.size(), 6u);
+  size_t dynamic_points = 0;
+  for (int frame : {0, 9}) {
+    const SimulatedFrame f = sim.SimulateFrame(frame);
+    for (size_t k = 0; k < f.sweep.scan.size(); ++k) {
+      const double t = f.sweep.point_time_s[k];
+      const Eigen::Vector3d p_world = TWorldLidar(sim, t) * f.sweep.scan.points_lidar[k];
+      double nearest = 1e9;
+      for (int o : moving) nearest = std::min(nearest, DistanceToObject(scene, o, p_world, t));
+      const uint8_t label = f.sweep.labels[k];
+      if (label == static_cast<uint8_t>(PointLabel::kDynamic)) {
+        ++dynamic_points;
+        ASSERT_LT(nearest, 0.1) << "dynamic point " << k << " is off every moving object";
+      } else if (nearest < 0.1) {
+        // Only the ground a pedestrian stands on touches a moving object.
+        ASSERT_EQ(label, static_cast<uint8_t>(PointLabel::kGround)) << "point " << k;
+        ASSERT_LT(std::min(std::abs(p_world.z()), std::abs(p_world.z() - 0.15)), 0.1);
+      }
+    }
+  }
+  EXPECT_GT(dynamic_points, 300u);
+}
+
+TEST(Simulator, RejectsBadOptionsAndLeavesNothingBehind) {
+  SimulatorOptions options;
+  for (auto mutate : std::vector<void (*)(SimulatorOptions*)>{
+           [](SimulatorOptions* o) { o->frames = 0; },
+           [](SimulatorOptions* o) { o->frames = -3; },
+           [](SimulatorOptions* o) { o->lidar_hz = 0; },
+           [](SimulatorOptions* o) { o->lidar_hz = 1000; },
+           [](SimulatorOptions* o) { o->time_offset_s = 2.0; },
+           [](SimulatorOptions* o) { o->time_offset_s = std::nan(""); },
+           [](SimulatorOptions* o) { o->dynamic_objects = -1; }}) {
+    SimulatorOptions bad = options;
+    mutate(&bad);
+    EXPECT_FALSE(bad.Validate().ok());
+  }
+  ScopedTempDir tmp;
+  stcalib::testing::WriteFile(tmp.path() + "/file", "x");
+  std::string drive;
+  const Status status = WriteSimulatedDrive(SmallOptions(1, 1), tmp.path() + "/file/sub", &drive);
+  EXPECT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), ::testing::HasSubstr(tmp.path() + "/file/sub"));
+  // An existing drive is never overwritten, and a failed run leaves no partial folder.
+  ASSERT_TRUE(WriteSimulatedDrive(SmallOptions(1, 1), tmp.path() + "/out", &drive).ok());
+  const Status again = WriteSimulatedDrive(SmallOptions(1, 1), tmp.path() + "/out", &drive);
+  EXPECT_FALSE(again.ok());
+  EXPECT_THAT(again.message(), ::testing::HasSubstr("already exists"));
+  int entries = 0;
+  for (const auto& e : std::filesystem::directory_iterator(tmp.path() + "/out")) {
+    (void)e;
+    ++entries;
+  }
+  EXPECT_EQ(entries, 1);
+}
+
+}  // namespace
+}  // namespace stcalib::sim
