@@ -88,5 +88,37 @@ TEST(Cli, BadInputExitsNonZeroNamingTheFile) {
   EXPECT_THAT(unwritable.output, HasSubstr("no/such/dir/x.png"));
 }
 
+TEST(Cli, SimulateWritesAReadableDrive) {
+  testing::ScopedTempDir tmp;
+  const RunResult sim = RunStcalib("simulate --out=" + tmp.path() +
+                                   " --frames=2 --seed=9 --time_offset_s=0.02");
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const std::string drive = tmp.path() + "/2026_01_10/2026_01_10_drive_0001_sync";
+  EXPECT_THAT(sim.output, HasSubstr(drive));
+  const RunResult info = RunStcalib("info --drive=" + drive);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_THAT(info.output, HasSubstr("frames       2"));
+  EXPECT_TRUE(std::filesystem::exists(tmp.path() + "/2026_01_10/ground_truth.json"));
+}
+
+TEST(Cli, SimulateRejectsBadFlags) {
+  testing::ScopedTempDir tmp;
+  const std::string out = " --out=" + tmp.path() + "/o";
+  for (const std::string& flags :
+       {std::string("--frames=0"), std::string("--frames=-5"), std::string("--lidar_hz=500"),
+        std::string("--lidar_hz=0"), std::string("--time_offset_s=3"),
+        std::string("--dynamic_objects=-1"), std::string("--scene=forest")}) {
+    const RunResult r = RunStcalib("simulate" + out + " " + flags);
+    EXPECT_EQ(r.exit_code, 2) << flags << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr("usage error")) << flags;
+  }
+  EXPECT_FALSE(std::filesystem::exists(tmp.path() + "/o"));
+  EXPECT_EQ(RunStcalib("simulate --frames=2").exit_code, 2);  // no --out
+  testing::WriteFile(tmp.path() + "/file", "x");
+  const RunResult unwritable = RunStcalib("simulate --frames=1 --out=" + tmp.path() + "/file/sub");
+  EXPECT_EQ(unwritable.exit_code, 1);
+  EXPECT_THAT(unwritable.output, HasSubstr(tmp.path() + "/file/sub"));
+}
+
 }  // namespace
 }  // namespace stcalib
