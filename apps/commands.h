@@ -15,6 +15,7 @@ constexpr int kExitUsage = 2;    ///< unknown subcommand, missing or invalid fla
 int RunInfo();
 int RunProject();
 int RunSimulate();
+int RunFeatures();
 
 // Prints "stcalib <command>: error: <message>" to stderr and returns kExitFailure.
 int ReportError(const std::string& command, const Status& status);

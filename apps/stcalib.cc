@@ -32,6 +32,9 @@ const std::vector<Subcommand>& Subcommands() {
        "[--dynamic_objects=K (6)] [--scene=urban|poles|open] [--lidar_hz=10]",
        "a KITTI-raw drive with exact ground truth (extrinsic, time offset, motion, labels)",
        &RunSimulate},
+      {"features", "--drive=DRIVE_DIR --frame=I --out=DIR [--calib_dir=DIR]",
+       "image edge mask and IDT, LiDAR edge points (vertical, horizontal, dynamic) as PNGs",
+       &RunFeatures},
   };
   return kSubcommands;
 }

@@ -1,0 +1,153 @@
+#include "core/features/image_features.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glog/logging.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/ximgproc/fast_line_detector.hpp>
+
+namespace stcalib {
+namespace {
+
+void Smooth(cv::Mat* map, double sigma_px) {
+  if (sigma_px > 0) cv::GaussianBlur(*map, *map, cv::Size(), sigma_px, sigma_px, cv::BORDER_REPLICATE);
+}
+
+// Draws segments at least min_length long (full-size coordinates) into the mask.
+void DrawSegments(const std::vector<cv::Vec4f>& segments, double min_length, cv::Mat* mask) {
+  for (const cv::Vec4f& s : segments) {
+    if (std::hypot(s[2] - s[0], s[3] - s[1]) < min_length) continue;
+    cv::line(*mask, cv::Point2f(s[0], s[1]), cv::Point2f(s[2], s[3]), cv::Scalar(255), 1,
+             cv::LINE_8);
+  }
+}
+
+std::vector<cv::Vec4f> DetectSegments(const cv::Mat& gray, const ImageFeatureOptions& options) {
+  cv::Mat small = gray;
+  if (options.line_scale < 1.0) {
+    cv::resize(gray, small, cv::Size(), options.line_scale, options.line_scale, cv::INTER_AREA);
+  }
+  std::vector<cv::Vec4f> segments;
+  if (options.detector == ImageFeatureOptions::Detector::kLsd) {
+    cv::Ptr<cv::LineSegmentDetector> lsd = cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
+    lsd->detect(small, segments);
+  } else {
+    cv::Ptr<cv::ximgproc::FastLineDetector> fld = cv::ximgproc::createFastLineDetector(
+        /*length_threshold=*/10, /*distance_threshold=*/1.414f, options.canny_low,
+        options.canny_high, /*canny_aperture_size=*/3, /*do_merge=*/false);
+    fld->detect(small, segments);
+  }
+  const float inv = static_cast<float>(1.0 / options.line_scale);
+  for (cv::Vec4f& s : segments) s *= inv;
+  return segments;
+}
+
+}  // namespace
+
+Status ImageFeatureOptions::Validate() const {
+  if (!(basin_px > 0)) return Status::Error("image features: basin_px must be > 0");
+  if (!(line_scale > 0 && line_scale <= 1)) {
+    return Status::Error("image features: line_scale must be in (0, 1]");
+  }
+  if (pre_blur_sigma_px < 0 || smoothing_sigma_px < 0 || suppression_sigma_px <= 0) {
+    return Status::Error("image features: blur sigmas must be >= 0 (suppression > 0)");
+  }
+  if (canny_low < 0 || canny_high < canny_low) {
+    return Status::Error("image features: need 0 <= canny_low <= canny_high");
+  }
+  for (double b : pyramid_basins_px) {
+    if (!(b > 0)) return Status::Error("image features: pyramid basins must be > 0");
+  }
+  return Status::Ok();
+}
+
+cv::Mat InverseDistanceTransform(const cv::Mat& distance_px, double basin_px, double sigma_px) {
+  cv::Mat idt;
+  // 255·(1 − D/basin), clipped at 0.
+  distance_px.convertTo(idt, CV_32F, -255.0 / basin_px, 255.0);
+  cv::max(idt, 0.0, idt);
+  Smooth(&idt, sigma_px);
+  return idt;
+}
+
+cv::Mat SuppressTexture(const cv::Mat& idt, double sigma_px) {
+  // The wide blur at a quarter of the resolution costs ~1/16 of a full-size one.
+  const double scale = sigma_px >= 8 ? 0.25 : 1.0;
+  cv::Mat small, blurred;
+  cv::resize(idt, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  cv::GaussianBlur(small, small, cv::Size(), sigma_px * scale, sigma_px * scale,
+                   cv::BORDER_REPLICATE);
+  cv::resize(small, blurred, idt.size(), 0, 0, cv::INTER_LINEAR);
+  cv::Mat out = idt - blurred;
+  cv::max(out, 0.0, out);
+  return out;
+}
+
+ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptions& options) {
+  CHECK(options.Validate().ok()) << options.Validate().message();
+  ImageFeatures features;
+  if (image.empty()) {
+    LOG(WARNING) << "image features: empty image, no features";
+    return features;
+  }
+  cv::Mat gray;
+  if (image.channels() == 3) {
+    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+  } else if (image.channels() == 4) {
+    cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
+  } else {
+    gray = image;
+  }
+  if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
+  cv::Mat blurred = gray;
+  if (options.pre_blur_sigma_px > 0) {
+    cv::GaussianBlur(gray, blurred, cv::Size(), options.pre_blur_sigma_px);
+  }
+
+  features.edge_mask = cv::Mat::zeros(gray.size(), CV_8U);
+  const cv::Rect full(0, 0, gray.cols, gray.rows);
+  const cv::Rect roi =
+      options.region_of_interest.area() > 0 ? (options.region_of_interest & full) : full;
+  if (roi.area() > 0) {
+    cv::Mat mask_roi = features.edge_mask(roi);
+    if (options.detector == ImageFeatureOptions::Detector::kCanny) {
+      cv::Canny(blurred(roi), mask_roi, options.canny_low, options.canny_high);
+    } else {
+      features.segments = DetectSegments(blurred(roi), options);
+      for (cv::Vec4f& s : features.segments) {
+        s += cv::Vec4f(roi.x, roi.y, roi.x, roi.y);
+      }
+      DrawSegments(features.segments, options.min_segment_length_px, &features.edge_mask);
+    }
+  }
+  features.edge_pixels = cv::countNonZero(features.edge_mask);
+
+  if (features.edge_pixels == 0) {
+    LOG(WARNING) << "image features: no edges found (black, flat or featureless image)";
+    features.distance_px = cv::Mat(gray.size(), CV_32F, cv::Scalar(options.basin_px));
+    features.distance_raw_px = cv::Mat(gray.size(), CV_32F, cv::Scalar(1e6));
+    features.idt = cv::Mat::zeros(gray.size(), CV_32F);
+    features.idt_suppressed = features.idt.clone();
+    for (size_t i = 0; i < options.pyramid_basins_px.size(); ++i) {
+      features.idt_pyramid.push_back(features.idt.clone());
+    }
+    return features;
+  }
+
+  cv::distanceTransform(255 - features.edge_mask, features.distance_raw_px, cv::DIST_L2,
+                        cv::DIST_MASK_5);
+  const cv::Mat& distance = features.distance_raw_px;
+  features.idt = InverseDistanceTransform(distance, options.basin_px, options.smoothing_sigma_px);
+  features.idt_suppressed = SuppressTexture(features.idt, options.suppression_sigma_px);
+  for (double basin : options.pyramid_basins_px) {
+    features.idt_pyramid.push_back(SuppressTexture(
+        InverseDistanceTransform(distance, basin, std::max(options.smoothing_sigma_px, basin / 10)),
+        std::max(options.suppression_sigma_px, basin)));
+  }
+  cv::min(distance, options.basin_px, features.distance_px);
+  Smooth(&features.distance_px, options.smoothing_sigma_px);
+  return features;
+}
+
+}  // namespace stcalib

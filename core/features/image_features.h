@@ -1,0 +1,61 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/types/status.h"
+
+namespace stcalib {
+
+// Image line features (method.md §4): grayscale → (blur) → edges → distance transform D →
+// inverse distance transform IDT = 255·max(0, 1 − D/basin), smoothed. Projected LiDAR edge
+// points read the IDT (higher = nearer an edge); the refinement samples the smoothed, capped
+// distance map with a bicubic interpolator.
+struct ImageFeatureOptions {
+  enum class Detector {
+    kCanny,     ///< Canny edges (fast per-frame path, ≈ 5 ms on 1242×375)
+    kLsd,       ///< OpenCV LSD segments drawn into the mask
+    kFastLine,  ///< cv::ximgproc FastLineDetector segments drawn into the mask
+  };
+  Detector detector = Detector::kCanny;
+  double pre_blur_sigma_px = 1.0;   ///< Gaussian σ before edge detection [px], 0 = none
+  double canny_low = 40;            ///< Canny hysteresis thresholds [grey levels]
+  double canny_high = 120;
+  double line_scale = 0.5;          ///< image scale LSD / FastLineDetector run at (0, 1]
+  double min_segment_length_px = 15;  ///< shorter segments are texture, not drawn [px, full size]
+  double basin_px = 20;             ///< D_max of the IDT [px]
+  double smoothing_sigma_px = 1.5;  ///< Gaussian σ applied to the IDT and distance maps [px]
+  double suppression_sigma_px = 12;  ///< wide blur subtracted for the texture-suppressed map [px]
+  std::vector<double> pyramid_basins_px;  ///< extra texture-suppressed IDTs, e.g. {60, 30}
+  // Rectangle of interest (x, y, w, h) [px]; empty = whole image. Outside it the maps are flat.
+  cv::Rect region_of_interest;
+
+  Status Validate() const;
+};
+
+struct ImageFeatures {
+  cv::Mat edge_mask;        ///< CV_8U, 255 on edge pixels
+  cv::Mat distance_raw_px;  ///< CV_32F, exact distance to the nearest edge pixel [px]
+  cv::Mat distance_px;      ///< CV_32F, smoothed min(D, basin) [px]; 0 on edges
+  cv::Mat idt;              ///< CV_32F, smoothed IDT in [0, 255]
+  cv::Mat idt_suppressed;   ///< CV_32F, max(0, IDT − wide blur of IDT): dense texture fades
+  std::vector<cv::Mat> idt_pyramid;  ///< texture-suppressed IDTs at pyramid_basins_px
+  std::vector<cv::Vec4f> segments;   ///< line segments at full-size coordinates (LSD/FLD)
+  int edge_pixels = 0;
+
+  bool empty() const { return edge_pixels == 0; }
+};
+
+// Never fails on image content: an empty or edge-less image gives empty features (flat maps,
+// edge_pixels = 0) and a warning. `options` must be valid.
+ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptions& options);
+
+// IDT from a distance map: 255·max(0, 1 − D/basin), Gaussian-smoothed.
+cv::Mat InverseDistanceTransform(const cv::Mat& distance_px, double basin_px, double sigma_px);
+
+// Subtracts a wide blur (computed at reduced resolution) and clips at zero.
+cv::Mat SuppressTexture(const cv::Mat& idt, double sigma_px);
+
+}  // namespace stcalib

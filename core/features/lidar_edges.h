@@ -1,0 +1,59 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/features/lidar_rings.h"
+#include "core/io/velodyne.h"
+#include "core/types/status.h"
+
+namespace stcalib {
+
+// Per-point role for edge extraction.
+enum class PointUse : uint8_t {
+  kUse = 0,      ///< ordinary return
+  kGround = 1,   ///< ground: never an edge; counts as far background along a ring
+  kDynamic = 2,  ///< moving object: never an edge, and no edge is declared against it
+};
+
+// Depth-discontinuity edges (method.md §4). Along a ring a jump in range marks a vertical edge
+// (an object's left/right silhouette); between vertically adjacent rings at the same azimuth it
+// marks a horizontal one (tops and overhangs). The nearer side is kept, and only where it is
+// smooth: its next points away from the jump continue the surface. Foliage, whose returns
+// scatter in depth, fails that test (method.md §10).
+struct LidarEdgeOptions {
+  double min_range_m = 2.0;          ///< nearer edge points are dropped [m]
+  double max_range_m = 70.0;         ///< farther edge points are dropped [m]
+  double jump_min_m = 0.3;           ///< range jump that makes an edge, at 0 m [m]
+  double jump_per_range = 0.02;      ///< added per metre of the near range [m/m]
+  double smooth_tolerance_m = 0.15;  ///< near-side continuity between neighbours, at 0 m [m]
+  double smooth_per_range = 0.005;   ///< added per metre of range [m/m]
+  int smooth_neighbours = 2;         ///< near-side neighbours that must continue the surface
+  double max_gap_steps = 4;          ///< a larger azimuth gap between returns is "no return"
+  bool horizontal_edges = true;      ///< also detect cross-ring (horizontal) edges
+
+  Status Validate() const;
+};
+
+enum class EdgeKind : uint8_t { kVertical = 0, kHorizontal = 1 };
+
+struct LidarEdges {
+  std::vector<Eigen::Vector3d> points_lidar;
+  std::vector<double> time_s;    ///< capture time relative to the sweep stamp [s]
+  std::vector<EdgeKind> kind;
+  std::vector<int> source_index;  ///< index in the scan (−1 after merging into a local map)
+
+  size_t size() const { return points_lidar.size(); }
+  bool empty() const { return points_lidar.empty(); }
+  void Append(const LidarEdges& other);
+};
+
+// `use` (optional, one entry per point) marks ground and dynamic points; `point_time_s` gives
+// every point's capture time. An empty scan gives empty edges and a warning.
+LidarEdges ExtractLidarEdges(const LidarScan& scan, const ScanRings& rings,
+                             const std::vector<double>& point_time_s,
+                             const std::vector<PointUse>* use, const LidarEdgeOptions& options);
+
+}  // namespace stcalib

@@ -1,0 +1,70 @@
+#include "core/features/lidar_rings.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace stcalib {
+
+ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points) {
+  ScanRings rings;
+  const int n = static_cast<int>(points.size());
+  rings.ring.resize(n);
+  rings.azimuth_rad.resize(n);
+  rings.range_m.resize(n);
+  for (int i = 0; i < n; ++i) {
+    rings.azimuth_rad[i] = static_cast<float>(std::atan2(points[i].y(), points[i].x()));
+    rings.range_m[i] = static_cast<float>(points[i].norm());
+  }
+  rings.ring_begin.push_back(0);
+  bool passed_back = false;  // the current laser has swept past the rear
+  for (int i = 1; i < n; ++i) {
+    const float a0 = rings.azimuth_rad[i - 1], a1 = rings.azimuth_rad[i];
+    if (a1 < a0 - static_cast<float>(M_PI / 2)) passed_back = true;  // wrap or rear gap
+    if (passed_back && a0 < 0 && a1 >= 0) {
+      rings.ring_begin.push_back(i);
+      passed_back = false;
+    }
+  }
+  rings.ring_begin.push_back(n);
+  if (n == 0) rings.ring_begin = {0};
+
+  std::vector<double> steps, elevation(rings.num_rings(), 0.0);
+  for (int r = 0; r < rings.num_rings(); ++r) {
+    double sum = 0;
+    int count = 0;
+    for (int i = rings.ring_begin[r]; i < rings.ring_begin[r + 1]; ++i) {
+      rings.ring[i] = static_cast<uint16_t>(r);
+      if (rings.range_m[i] > 0.5f) {
+        sum += std::asin(std::clamp(points[i].z() / rings.range_m[i], -1.0, 1.0));
+        ++count;
+      }
+      if (i > rings.ring_begin[r] && (i % 7) == 0) {
+        const double d = std::remainder(rings.azimuth_rad[i] - rings.azimuth_rad[i - 1], 2 * M_PI);
+        if (d > 0 && d < 0.02) steps.push_back(d);
+      }
+    }
+    elevation[r] = count > 0 ? sum / count : 0.0;
+  }
+  if (!steps.empty()) {
+    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+    rings.azimuth_step_rad = steps[steps.size() / 2];
+  }
+  rings.order_by_elevation.resize(rings.num_rings());
+  std::iota(rings.order_by_elevation.begin(), rings.order_by_elevation.end(), 0);
+  std::stable_sort(rings.order_by_elevation.begin(), rings.order_by_elevation.end(),
+                   [&](int a, int b) { return elevation[a] > elevation[b]; });
+  rings.elevation_rank.resize(rings.num_rings());
+  for (int k = 0; k < rings.num_rings(); ++k) rings.elevation_rank[rings.order_by_elevation[k]] = k;
+  return rings;
+}
+
+std::vector<double> PointTimesFromAzimuth(const ScanRings& rings, double sweep_duration_s) {
+  std::vector<double> times(rings.azimuth_rad.size());
+  for (size_t i = 0; i < times.size(); ++i) {
+    times[i] = -rings.azimuth_rad[i] / (2 * M_PI) * sweep_duration_s;
+  }
+  return times;
+}
+
+}  // namespace stcalib

@@ -1,0 +1,32 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace stcalib {
+
+// Beams (rings) of a spinning-LiDAR sweep stored in KITTI order, which has no ring field
+// (method.md §10): each laser's points run counter-clockwise from just left of straight ahead all
+// the way round to just right of it, and lasers follow each other. A laser ends where the
+// azimuth, having passed the ±180° wrap, crosses from negative to positive.
+struct ScanRings {
+  std::vector<uint16_t> ring;      ///< ring of every point, in file order
+  std::vector<float> azimuth_rad;  ///< atan2(y, x) of every point, (−π, π]
+  std::vector<float> range_m;      ///< |p| of every point
+  std::vector<int> ring_begin;     ///< first point of each ring; back() = number of points
+  std::vector<int> order_by_elevation;  ///< rings sorted from the top beam to the bottom one
+  std::vector<int> elevation_rank;      ///< inverse of order_by_elevation
+  double azimuth_step_rad = 0;     ///< median spacing of consecutive returns in a ring
+
+  int num_rings() const { return static_cast<int>(ring_begin.size()) - 1; }
+};
+
+ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points_lidar);
+
+// Capture time of every point relative to the sweep stamp, which KITTI puts mid-sweep when the
+// head faces forward; the head spins clockwise, so t = −azimuth / 2π · sweep_duration [s].
+std::vector<double> PointTimesFromAzimuth(const ScanRings& rings, double sweep_duration_s);
+
+}  // namespace stcalib

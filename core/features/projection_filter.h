@@ -1,0 +1,13 @@
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace stcalib {
+
+// The outlier kernel of method.md §4: a projected point with no other projected point within
+// `radius_px` (8 px in the paper) is dropped. Returns one flag per pixel, true = keep.
+std::vector<bool> KeepNonIsolated(const std::vector<Eigen::Vector2d>& pixels, double radius_px);
+
+}  // namespace stcalib

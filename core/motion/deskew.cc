@@ -1,0 +1,31 @@
+#include "core/motion/deskew.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stcalib {
+
+std::vector<Eigen::Vector3d> DeskewToStamp(const std::vector<Eigen::Vector3d>& points,
+                                           const std::vector<double>& time_s, double stamp_s,
+                                           const LidarPoseFunction& T_world_lidar, int bins) {
+  std::vector<Eigen::Vector3d> out(points.size());
+  if (points.empty()) return out;
+  const auto [lo_it, hi_it] = std::minmax_element(time_s.begin(), time_s.end());
+  const double lo = *lo_it, hi = *hi_it;
+  const Rigid3d T_stamp_inv = T_world_lidar(stamp_s).inverse();
+  bins = std::max(bins, 2);
+  std::vector<Rigid3d> table(bins);
+  const double width = hi > lo ? (hi - lo) / (bins - 1) : 1.0;
+  for (int k = 0; k < bins; ++k) table[k] = T_stamp_inv * T_world_lidar(stamp_s + lo + k * width);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const int k = std::clamp(static_cast<int>(std::lround((time_s[i] - lo) / width)), 0, bins - 1);
+    out[i] = table[k] * points[i];
+  }
+  return out;
+}
+
+Rigid3d RelativeLidarPose(const LidarPoseFunction& T_world_lidar, double t_to_s, double t_from_s) {
+  return T_world_lidar(t_to_s).inverse() * T_world_lidar(t_from_s);
+}
+
+}  // namespace stcalib

@@ -1,0 +1,24 @@
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "core/types/transform.h"
+
+namespace stcalib {
+
+// T_world_lidar at a time given in seconds relative to some reference.
+using LidarPoseFunction = std::function<Rigid3d(double t_s)>;
+
+// Moves every point of a sweep from its own capture time (stamp_s + time_s[i]) to the sweep
+// stamp: p_stamp = T_world_lidar(stamp)⁻¹ · T_world_lidar(stamp + t_i) · p_i. The relative poses
+// are tabulated at `bins` times across the sweep (≤ 0.5 ms apart for a 0.1 s sweep with the
+// default), so the cost is one table lookup per point.
+std::vector<Eigen::Vector3d> DeskewToStamp(const std::vector<Eigen::Vector3d>& points_lidar,
+                                           const std::vector<double>& time_s, double stamp_s,
+                                           const LidarPoseFunction& T_world_lidar, int bins = 256);
+
+// Pose of the sweep stamped t_from in the frame of the sweep stamped t_to.
+Rigid3d RelativeLidarPose(const LidarPoseFunction& T_world_lidar, double t_to_s, double t_from_s);
+
+}  // namespace stcalib

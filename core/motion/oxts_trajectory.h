@@ -1,0 +1,36 @@
+#pragma once
+
+#include <vector>
+
+#include "core/io/oxts.h"
+#include "core/io/timestamps.h"
+#include "core/motion/oxts_poses.h"
+#include "core/types/status.h"
+#include "core/types/transform.h"
+
+namespace stcalib {
+
+// The vehicle (IMU) pose at any time from a drive's oxts packets: GPS/INS poses at the packet
+// stamps (oxts_poses.h, origin at the first packet), cubic Hermite interpolation of the position
+// with the packets' velocities, slerp of the attitude; beyond the first/last packet the pose is
+// extrapolated with that packet's velocity and body rates.
+class OxtsTrajectory {
+ public:
+  // Stamps must increase strictly; errors name the offending packet.
+  static Status Create(const std::vector<OxtsPacket>& packets, const std::vector<StampNs>& stamps_ns,
+                       OxtsTrajectory* trajectory);
+
+  Rigid3d T_world_imu(StampNs stamp_ns) const;
+  Rigid3d T_world_imu_s(double seconds_since_reference) const;
+  StampNs reference_ns() const { return reference_ns_; }
+  size_t size() const { return times_s_.size(); }
+
+ private:
+  StampNs reference_ns_ = 0;
+  std::vector<double> times_s_;
+  std::vector<Rigid3d> poses_;
+  std::vector<Eigen::Vector3d> velocities_world_;
+  std::vector<Eigen::Vector3d> rates_body_;
+};
+
+}  // namespace stcalib
