@@ -50,7 +50,16 @@ int RunFeatures() {
   cv::Mat image;
   status = drive.LoadImage(frame, &image);
   if (!status.ok()) return ReportError("features", status);
-  const ImageFeatureOptions image_options;
+  ImageFeatureOptions image_options;
+  if (FLAGS_detector == "lsd") {
+    image_options.detector = ImageFeatureOptions::Detector::kLsd;
+  } else if (FLAGS_detector == "fld") {
+    image_options.detector = ImageFeatureOptions::Detector::kFastLine;
+  } else if (FLAGS_detector != "canny") {
+    return UsageError("features", "--detector must be canny, lsd or fld");
+  }
+  image_options.min_segment_length_px = FLAGS_min_segment_px;
+  image_options.max_edge_density = FLAGS_max_edge_density;
   const ImageFeatures image_features = ExtractImageFeatures(image, image_options);
   LidarFrameFeatures lidar;
   status = LoadLidarFrameFeatures(drive, motion, frame, LidarFeatureOptions(), &lidar);
@@ -61,6 +70,9 @@ int RunFeatures() {
   const Rigid3d T_camera_lidar =
       drive.T_camera_lidar * RelativeLidarPose(motion.PoseFunction(), camera_s, lidar.stamp_s);
   const CameraModel camera = CameraModel::FromCalibration(drive.camera, image.cols, image.rows);
+  const AlignmentStats oriented = MeasureOrientedAlignment(
+      ProjectPoints(camera, T_camera_lidar, lidar.edges.points_lidar), lidar.edges.kind,
+      image_features.distance_vertical_raw_px, image_features.distance_horizontal_raw_px, 3.0, 8.0);
   std::vector<Eigen::Vector3d> vertical, horizontal, dynamic;
   for (size_t i = 0; i < lidar.edges.size(); ++i) {
     (lidar.edges.kind[i] == EdgeKind::kVertical ? vertical : horizontal)
@@ -82,13 +94,22 @@ int RunFeatures() {
   Draw(&overlay, projected_d, cv::Scalar(255, 0, 255));   // removed dynamic points: magenta
   Draw(&overlay, projected_v, cv::Scalar(80, 255, 80));   // vertical edges: green
   Draw(&overlay, projected_h, cv::Scalar(0, 170, 255));   // horizontal edges: orange
+  // Edge mask with the projected LiDAR edges: green within 3 px of an edge, red beyond.
+  cv::Mat check;
+  cv::cvtColor(image_features.edge_mask / 2, check, cv::COLOR_GRAY2BGR);
+  for (const ProjectedPoint& p : all) {
+    const int u = static_cast<int>(std::lround(p.pixel.x())), v = static_cast<int>(std::lround(p.pixel.y()));
+    const bool near = image_features.distance_raw_px.at<float>(v, u) <= 3.0f;
+    cv::circle(check, cv::Point(u, v), 2, near ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255), cv::FILLED);
+  }
   const std::string out = FLAGS_out;
   for (const auto& [name, picture] :
        std::vector<std::pair<std::string, cv::Mat>>{
            {"edge_mask.png", image_features.edge_mask},
            {"idt.png", Colourise(image_features.idt)},
            {"idt_suppressed.png", Colourise(image_features.idt_suppressed * 2.0)},
-           {"lidar_edges.png", overlay}}) {
+           {"lidar_edges.png", overlay},
+           {"alignment.png", check}}) {
     status = WriteImage(out + "/" + name, picture);
     if (!status.ok()) return ReportError("features", status);
   }
@@ -105,7 +126,9 @@ int RunFeatures() {
   std::printf("  alignment  %.1f%% of %d projected edge points within 3 px of an image edge "
               "(median %.2f px)\n",
               100 * alignment.rate, alignment.kept, alignment.median_distance_px);
-  std::printf("  wrote      %s/{edge_mask,idt,idt_suppressed,lidar_edges}.png\n", out.c_str());
+  std::printf("  oriented   %.1f%% within 3 px of an image edge of the same orientation\n",
+              100 * oriented.rate);
+  std::printf("  wrote      %s/{edge_mask,idt,idt_suppressed,lidar_edges,alignment}.png\n", out.c_str());
   return kExitOk;
 }
 

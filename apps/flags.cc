@@ -13,3 +13,7 @@ DEFINE_double(time_offset_s, 0.0,
 DEFINE_int32(dynamic_objects, 6, "simulate: moving vehicles and pedestrians");
 DEFINE_string(scene, "urban", "simulate: urban | poles (vertical structures only) | open");
 DEFINE_double(lidar_hz, 10.0, "simulate: LiDAR spin rate = frame rate of every sensor [Hz]");
+DEFINE_string(detector, "canny", "image edges: canny | lsd | fld (cv::ximgproc FastLineDetector)");
+DEFINE_double(min_segment_px, 15, "lsd/fld: shorter segments are dropped as texture [px]");
+DEFINE_double(max_edge_density, 0.0,
+              "features: drop edge pixels in windows denser than this share (texture), 0 = off");

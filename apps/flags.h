@@ -14,3 +14,6 @@ DECLARE_double(time_offset_s);
 DECLARE_int32(dynamic_objects);
 DECLARE_string(scene);
 DECLARE_double(lidar_hz);
+DECLARE_string(detector);
+DECLARE_double(min_segment_px);
+DECLARE_double(max_edge_density);

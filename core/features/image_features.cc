@@ -53,6 +53,9 @@ Status ImageFeatureOptions::Validate() const {
   if (pre_blur_sigma_px < 0 || smoothing_sigma_px < 0 || suppression_sigma_px <= 0) {
     return Status::Error("image features: blur sigmas must be >= 0 (suppression > 0)");
   }
+  if (max_edge_density < 0 || max_edge_density > 1 || density_window_px < 1) {
+    return Status::Error("image features: max_edge_density in [0, 1], density_window_px >= 1");
+  }
   if (canny_low < 0 || canny_high < canny_low) {
     return Status::Error("image features: need 0 <= canny_low <= canny_high");
   }
@@ -121,6 +124,16 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
       DrawSegments(features.segments, options.min_segment_length_px, &features.edge_mask);
     }
   }
+  if (options.max_edge_density > 0) {
+    cv::Mat density;
+    const int window = 2 * options.density_window_px + 1;
+    cv::boxFilter(features.edge_mask, density, CV_32F, cv::Size(window, window), cv::Point(-1, -1),
+                  /*normalize=*/true, cv::BORDER_REPLICATE);
+    const cv::Mat dense = density > 255.0 * options.max_edge_density;
+    const int before = cv::countNonZero(features.edge_mask);
+    features.edge_mask.setTo(0, dense);
+    features.dense_pixels_removed = before - cv::countNonZero(features.edge_mask);
+  }
   features.edge_pixels = cv::countNonZero(features.edge_mask);
 
   if (features.edge_pixels == 0) {
@@ -137,6 +150,18 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
 
   cv::distanceTransform(255 - features.edge_mask, features.distance_raw_px, cv::DIST_L2,
                         cv::DIST_MASK_5);
+  if (options.split_orientation) {
+    // Gradient mostly along x = a near-vertical line; the 30° band in between goes to both.
+    cv::Mat gx, gy;
+    cv::Sobel(blurred, gx, CV_32F, 1, 0, 3);
+    cv::Sobel(blurred, gy, CV_32F, 0, 1, 3);
+    const cv::Mat abs_gx = cv::abs(gx), abs_gy = cv::abs(gy);
+    const cv::Mat vertical = (abs_gx * 0.577f >= abs_gy) & features.edge_mask;    // within 30° of vertical
+    const cv::Mat horizontal = (abs_gy * 0.577f >= abs_gx) & features.edge_mask;  // within 30° of horizontal
+    cv::distanceTransform(255 - vertical, features.distance_vertical_raw_px, cv::DIST_L2, cv::DIST_MASK_5);
+    cv::distanceTransform(255 - horizontal, features.distance_horizontal_raw_px, cv::DIST_L2,
+                          cv::DIST_MASK_5);
+  }
   const cv::Mat& distance = features.distance_raw_px;
   features.idt = InverseDistanceTransform(distance, options.basin_px, options.smoothing_sigma_px);
   features.idt_suppressed = SuppressTexture(features.idt, options.suppression_sigma_px);

@@ -29,6 +29,14 @@ struct ImageFeatureOptions {
   double smoothing_sigma_px = 1.5;  ///< Gaussian σ applied to the IDT and distance maps [px]
   double suppression_sigma_px = 12;  ///< wide blur subtracted for the texture-suppressed map [px]
   std::vector<double> pyramid_basins_px;  ///< extra texture-suppressed IDTs, e.g. {60, 30}
+  // Texture suppression on the edge mask: edge pixels whose (2·density_window_px+1)² window is
+  // denser than this share of edge pixels are dropped (foliage, gravel); 0 = keep all.
+  double max_edge_density = 0.0;
+  int density_window_px = 7;
+  // Also split the edges by orientation (Sobel gradient) into near-vertical and near-horizontal
+  // lines with one distance map each, so that vertical LiDAR edges are compared with vertical
+  // image edges only (dense texture has every orientation; structure has one).
+  bool split_orientation = true;
   // Rectangle of interest (x, y, w, h) [px]; empty = whole image. Outside it the maps are flat.
   cv::Rect region_of_interest;
 
@@ -39,11 +47,14 @@ struct ImageFeatures {
   cv::Mat edge_mask;        ///< CV_8U, 255 on edge pixels
   cv::Mat distance_raw_px;  ///< CV_32F, exact distance to the nearest edge pixel [px]
   cv::Mat distance_px;      ///< CV_32F, smoothed min(D, basin) [px]; 0 on edges
+  cv::Mat distance_vertical_raw_px;    ///< exact distance to near-vertical edge pixels [px]
+  cv::Mat distance_horizontal_raw_px;  ///< exact distance to near-horizontal edge pixels [px]
   cv::Mat idt;              ///< CV_32F, smoothed IDT in [0, 255]
   cv::Mat idt_suppressed;   ///< CV_32F, max(0, IDT − wide blur of IDT): dense texture fades
   std::vector<cv::Mat> idt_pyramid;  ///< texture-suppressed IDTs at pyramid_basins_px
   std::vector<cv::Vec4f> segments;   ///< line segments at full-size coordinates (LSD/FLD)
-  int edge_pixels = 0;
+  int edge_pixels = 0;      ///< after texture suppression
+  int dense_pixels_removed = 0;
 
   bool empty() const { return edge_pixels == 0; }
 };

@@ -33,6 +33,12 @@ struct LidarEdgeOptions {
   int smooth_neighbours = 2;         ///< near-side neighbours that must continue the surface
   double max_gap_steps = 4;          ///< a larger azimuth gap between returns is "no return"
   bool horizontal_edges = true;      ///< also detect cross-ring (horizontal) edges
+  // Edge runs: a real vertical edge continues in the rings above or below (an edge point at
+  // nearly the same azimuth and range), a horizontal one along its ring. Points without
+  // `run_support` such neighbours are dropped: scattered foliage edges do not line up.
+  int run_support = 1;
+  double run_azimuth_deg = 0.6;      ///< azimuth window for a vertical-edge neighbour [deg]
+  double run_range_tolerance = 0.05;  ///< relative range difference allowed within a run
 
   Status Validate() const;
 };

@@ -7,12 +7,15 @@
 
 namespace stcalib {
 
-AlignmentStats MeasureAlignment(const std::vector<ProjectedPoint>& projected,
-                                const cv::Mat& distance_raw_px, double threshold_px,
-                                double isolation_radius_px) {
+namespace {
+
+// `map_of(i)` gives the distance map point i reads.
+template <typename MapOf>
+AlignmentStats Measure(const std::vector<ProjectedPoint>& projected, const MapOf& map_of,
+                       double threshold_px, double isolation_radius_px) {
   AlignmentStats stats;
   stats.projected = static_cast<int>(projected.size());
-  if (projected.empty() || distance_raw_px.empty()) return stats;
+  if (projected.empty()) return stats;
   std::vector<Eigen::Vector2d> pixels;
   pixels.reserve(projected.size());
   for (const ProjectedPoint& p : projected) pixels.push_back(p.pixel);
@@ -21,10 +24,11 @@ AlignmentStats MeasureAlignment(const std::vector<ProjectedPoint>& projected,
                                      : std::vector<bool>(pixels.size(), true);
   std::vector<float> distances;
   for (size_t i = 0; i < pixels.size(); ++i) {
-    if (!keep[i]) continue;
-    const int u = std::clamp(static_cast<int>(std::lround(pixels[i].x())), 0, distance_raw_px.cols - 1);
-    const int v = std::clamp(static_cast<int>(std::lround(pixels[i].y())), 0, distance_raw_px.rows - 1);
-    distances.push_back(distance_raw_px.at<float>(v, u));
+    const cv::Mat& map = map_of(i);
+    if (!keep[i] || map.empty()) continue;
+    const int u = std::clamp(static_cast<int>(std::lround(pixels[i].x())), 0, map.cols - 1);
+    const int v = std::clamp(static_cast<int>(std::lround(pixels[i].y())), 0, map.rows - 1);
+    distances.push_back(map.at<float>(v, u));
   }
   stats.kept = static_cast<int>(distances.size());
   if (distances.empty()) return stats;
@@ -34,6 +38,30 @@ AlignmentStats MeasureAlignment(const std::vector<ProjectedPoint>& projected,
   std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
   stats.median_distance_px = distances[distances.size() / 2];
   return stats;
+}
+
+}  // namespace
+
+AlignmentStats MeasureAlignment(const std::vector<ProjectedPoint>& projected,
+                                const cv::Mat& distance_raw_px, double threshold_px,
+                                double isolation_radius_px) {
+  return Measure(
+      projected, [&](size_t) -> const cv::Mat& { return distance_raw_px; }, threshold_px,
+      isolation_radius_px);
+}
+
+AlignmentStats MeasureOrientedAlignment(const std::vector<ProjectedPoint>& projected,
+                                        const std::vector<EdgeKind>& kinds,
+                                        const cv::Mat& distance_vertical_raw_px,
+                                        const cv::Mat& distance_horizontal_raw_px,
+                                        double threshold_px, double isolation_radius_px) {
+  return Measure(
+      projected,
+      [&](size_t i) -> const cv::Mat& {
+        return kinds[projected[i].index] == EdgeKind::kVertical ? distance_vertical_raw_px
+                                                                 : distance_horizontal_raw_px;
+      },
+      threshold_px, isolation_radius_px);
 }
 
 }  // namespace stcalib

@@ -4,6 +4,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/features/lidar_edges.h"
 #include "core/score/projection.h"
 
 namespace stcalib {
@@ -22,5 +23,15 @@ struct AlignmentStats {
 AlignmentStats MeasureAlignment(const std::vector<ProjectedPoint>& projected,
                                 const cv::Mat& distance_raw_px, double threshold_px,
                                 double isolation_radius_px);
+
+// Orientation-aware rate: a projected point whose source edge (projected[i].index into `kinds`)
+// is vertical reads the distance to near-vertical image edges, a horizontal one the distance to
+// near-horizontal image edges (ImageFeatures::distance_{vertical,horizontal}_raw_px). Dense
+// texture has edges of every orientation nearby; structure has the right one.
+AlignmentStats MeasureOrientedAlignment(const std::vector<ProjectedPoint>& projected,
+                                        const std::vector<EdgeKind>& kinds,
+                                        const cv::Mat& distance_vertical_raw_px,
+                                        const cv::Mat& distance_horizontal_raw_px,
+                                        double threshold_px, double isolation_radius_px);
 
 }  // namespace stcalib

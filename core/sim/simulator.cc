@@ -197,12 +197,16 @@ OxtsPacket Simulator::SimulateOxts(int frame) const {
   return SynthesizeOxtsPacket(*trajectory_, origin_, Timing(frame).oxts_time_s, &oxts_rng);
 }
 
+SimulatedSweep Simulator::SimulateSweep(int frame) const {
+  std::mt19937_64 lidar_rng = MakeRng(options_.seed, kFrameLidar, frame);
+  return SimulateLidarSweep(*scene_, *trajectory_, T_lidar_imu_.inverse(), lidar_,
+                            LidarMidTime(frame), SweepDuration(), &lidar_rng);
+}
+
 SimulatedFrame Simulator::SimulateFrame(int frame) const {
   SimulatedFrame out;
   static_cast<FrameTiming&>(out) = Timing(frame);
-  std::mt19937_64 lidar_rng = MakeRng(options_.seed, kFrameLidar, frame);
-  out.sweep = SimulateLidarSweep(*scene_, *trajectory_, T_lidar_imu_.inverse(), lidar_,
-                                 out.lidar_mid_time_s, SweepDuration(), &lidar_rng);
+  out.sweep = SimulateSweep(frame);
   std::mt19937_64 camera_rng = MakeRng(options_.seed, kFrameCamera, frame);
   out.image_bgr = RenderCameraImage(*scene_, *trajectory_, rig_, out.camera_time_s, &camera_rng);
   out.oxts = SimulateOxts(frame);

@@ -54,7 +54,8 @@ class Simulator {
 
   SimulatedFrame SimulateFrame(int frame) const;
   FrameTiming Timing(int frame) const;
-  OxtsPacket SimulateOxts(int frame) const;  ///< the packet of SimulateFrame(frame), alone
+  OxtsPacket SimulateOxts(int frame) const;      ///< the packet of SimulateFrame(frame), alone
+  SimulatedSweep SimulateSweep(int frame) const;  ///< the sweep of SimulateFrame(frame), alone
 
   const SimulatorOptions& options() const { return options_; }
   const Rigid3d& T_camera_lidar() const { return T_camera_lidar_; }
