@@ -152,8 +152,8 @@ TEST(LidarEdges, SimulatedEdgePointsLieOnTrueGeometricEdges) {
     for (int frame : {4, 15}) {
       const sim::SimulatedSweep sweep = s.SimulateSweep(frame);
       const LidarFrameFeatures f = ComputeLidarFrameFeatures(
-          sweep.scan, s.LidarMidTime(frame), s.SweepDuration(), TruthPose(s), nullptr,
-          Rigid3d::Identity(), LidarFeatureOptions());
+          sweep.scan, s.LidarMidTime(frame), s.SweepDuration(), TruthPose(s), {},
+          LidarFeatureOptions());
       ASSERT_GT(f.edges.size(), 500u);
       const double t_mid = s.LidarMidTime(frame);
       const Rigid3d T_mid = TruthPose(s)(t_mid);
@@ -211,8 +211,7 @@ TEST(ProjectionFilter, DropsIsolatedPointsOnly) {
 TEST(LidarEdges, EmptyAndDegenerateInputGiveEmptyFeatures) {
   const LidarScan empty;
   const LidarFrameFeatures f = ComputeLidarFrameFeatures(
-      empty, 0.0, 0.1, [](double) { return Rigid3d::Identity(); }, nullptr, Rigid3d::Identity(),
-      LidarFeatureOptions());
+      empty, 0.0, 0.1, [](double) { return Rigid3d::Identity(); }, {}, LidarFeatureOptions());
   EXPECT_TRUE(f.edges.empty());
   EXPECT_EQ(f.rings.num_rings(), 0);
   // Every point behind the camera: nothing projects, nothing aligns, nothing crashes.

@@ -1,6 +1,9 @@
 #include "core/features/dynamic_filter.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <numeric>
 #include <unordered_map>
 
@@ -9,6 +12,16 @@
 #include "core/features/kdtree.h"
 
 namespace stcalib {
+
+Status DynamicFilterOptions::Validate() const {
+  if (!(tau0_m > 0) || tau_per_range < 0 || !(max_range_m > 0) || !(cluster_tolerance_m > 0) ||
+      min_flagged_points < 1 || min_flagged_fraction < 0 || min_flagged_fraction > 1 ||
+      !(max_cluster_extent_m > 0) || roi_half_angle_deg < 0) {
+    return Status::Error("dynamic filter: thresholds must be positive (fraction in [0, 1])");
+  }
+  return Status::Ok();
+}
+
 namespace {
 
 bool InRegion(const Eigen::Vector3d& p, const DynamicFilterOptions& o, double extra_m) {
@@ -25,37 +38,91 @@ int Find(std::vector<int>& parent, int i) {
   return i;
 }
 
-}  // namespace
-
-Status DynamicFilterOptions::Validate() const {
-  if (!(tau0_m > 0) || tau_per_range < 0 || !(max_range_m > 0) || !(cluster_tolerance_m > 0) ||
-      min_flagged_points < 1 || min_flagged_fraction < 0 || min_flagged_fraction > 1 ||
-      !(max_cluster_extent_m > 0) || roi_half_angle_deg < 0) {
-    return Status::Error("dynamic filter: thresholds must be positive (fraction in [0, 1])");
+// Spherical range image of a sweep: the nearest return per (azimuth, elevation) cell.
+class RangeImage {
+ public:
+  explicit RangeImage(const std::vector<Eigen::Vector3d>& points) : range_(kAz * kEl, kEmpty) {
+    for (const auto& p : points) {
+      const int c = Cell(p);
+      if (c >= 0) range_[c] = std::min(range_[c], static_cast<float>(p.norm()));
+    }
   }
-  return Status::Ok();
+  // Nearest previous range in the 3×3 cells around the direction of p; +inf when nothing.
+  float RangeAround(const Eigen::Vector3d& p) const {
+    const int c = Cell(p);
+    if (c < 0) return kEmpty;
+    const int a = c % kAz, e = c / kAz;
+    float best = kEmpty;
+    for (int de = -1; de <= 1; ++de) {
+      if (e + de < 0 || e + de >= kEl) continue;
+      for (int da = -1; da <= 1; ++da) {
+        best = std::min(best, range_[(e + de) * kAz + (a + da + kAz) % kAz]);
+      }
+    }
+    return best;
+  }
+
+ private:
+  static constexpr int kAz = 1440, kEl = 160;  // 0.25° cells, elevation −30°..+10°
+  static constexpr float kEmpty = std::numeric_limits<float>::infinity();
+  static int Cell(const Eigen::Vector3d& p) {
+    const double az = std::atan2(p.y(), p.x());
+    const double el = std::atan2(p.z(), p.head<2>().norm());
+    const int a = static_cast<int>((az + M_PI) / (2 * M_PI) * kAz);
+    const int e = static_cast<int>((el * 180 / M_PI + 30.0) / 0.25);
+    if (e < 0 || e >= kEl) return -1;
+    return e * kAz + std::min(a, kAz - 1);
+  }
+  std::vector<float> range_;
+};
+
+// Flags the selected current points that `reference` cannot explain.
+void FlagAgainst(const std::vector<Eigen::Vector3d>& current, const std::vector<int>& selected,
+                 const ReferenceSweep& reference, const DynamicFilterOptions& options,
+                 std::vector<uint8_t>* flagged) {
+  const std::vector<Eigen::Vector3d>& own = *reference.points;
+  std::vector<Eigen::Vector3d> moved;
+  moved.reserve(own.size());
+  for (size_t i = 0; i < own.size(); ++i) {
+    if (reference.ground != nullptr && !reference.ground->empty() && (*reference.ground)[i]) continue;
+    const Eigen::Vector3d p = reference.T_current_reference * own[i];
+    if (InRegion(p, options, 5.0)) moved.push_back(p);
+  }
+  if (moved.empty()) return;
+  const PointKdTree tree(moved);
+  std::unique_ptr<RangeImage> view;
+  if (reference.check_visibility) view = std::make_unique<RangeImage>(own);
+  const Rigid3d T_reference_current = reference.T_current_reference.inverse();
+  for (size_t k = 0; k < selected.size(); ++k) {
+    if ((*flagged)[k]) continue;
+    const Eigen::Vector3d& p = current[selected[k]];
+    int nearest;
+    double distance;
+    tree.Nearest(p, &nearest, &distance);
+    if (distance <= options.tau0_m + options.tau_per_range * p.norm()) continue;  // τ(r)
+    if (view != nullptr) {
+      // Seen from the reference viewpoint, was this place free space (a longer return)?
+      const Eigen::Vector3d q = T_reference_current * p;
+      const double r = q.norm();
+      if (view->RangeAround(q) < r + options.visibility_margin_m + 0.02 * r) continue;
+    }
+    (*flagged)[k] = 1;
+  }
 }
+
+}  // namespace
 
 DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& current,
                                         const std::vector<uint8_t>& current_ground,
-                                        const std::vector<Eigen::Vector3d>& previous,
-                                        const std::vector<uint8_t>& previous_ground,
+                                        const std::vector<ReferenceSweep>& references,
                                         const DynamicFilterOptions& options) {
   CHECK(options.Validate().ok()) << options.Validate().message();
   CHECK(current_ground.empty() || current_ground.size() == current.size());
-  CHECK(previous_ground.empty() || previous_ground.size() == previous.size());
   DynamicFilterResult result;
   result.dynamic.assign(current.size(), 0);
-  if (current.empty() || previous.empty()) {
-    LOG(WARNING) << "dynamic filter: empty sweep, nothing removed";
+  if (current.empty() || references.empty()) {
+    LOG_IF(WARNING, current.empty()) << "dynamic filter: empty sweep, nothing removed";
     return result;
-  }
-  std::vector<Eigen::Vector3d> reference;
-  reference.reserve(previous.size());
-  for (size_t i = 0; i < previous.size(); ++i) {
-    if ((previous_ground.empty() || !previous_ground[i]) && InRegion(previous[i], options, 5.0)) {
-      reference.push_back(previous[i]);
-    }
   }
   std::vector<int> selected;
   for (size_t i = 0; i < current.size(); ++i) {
@@ -63,21 +130,13 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
       selected.push_back(static_cast<int>(i));
     }
   }
-  if (selected.empty() || reference.empty()) return result;
-
-  // Flag points without a close previous neighbour (Eq. τ(r) = τ0 + k·r).
-  const PointKdTree tree(reference);
+  if (selected.empty()) return result;
   std::vector<uint8_t> flagged(selected.size(), 0);
-  for (size_t k = 0; k < selected.size(); ++k) {
-    const Eigen::Vector3d& p = current[selected[k]];
-    int nearest;
-    double distance;
-    tree.Nearest(p, &nearest, &distance);
-    if (distance > options.tau0_m + options.tau_per_range * p.norm()) {
-      flagged[k] = 1;
-      ++result.flagged_points;
-    }
+  for (const ReferenceSweep& reference : references) {
+    CHECK(reference.points != nullptr);
+    FlagAgainst(current, selected, reference, options, &flagged);
   }
+  for (uint8_t f : flagged) result.flagged_points += f;
 
   // Euclidean clustering on a voxel grid: occupied voxels touching (26-neighbourhood) join.
   const double cell = options.cluster_tolerance_m;

@@ -6,14 +6,17 @@
 #include <Eigen/Core>
 
 #include "core/types/status.h"
+#include "core/types/transform.h"
 
 namespace stcalib {
 
 // Dynamic points (method.md §5): with the previous sweep motion-compensated into the current one,
 // a static point finds a close neighbour in it and a moving one does not. Points farther than
-// τ(r) = τ0 + k·r from their nearest previous neighbour are flagged; the current non-ground
-// points are clustered (Euclidean, on a voxel grid) and whole clusters with enough flagged points
-// are removed.
+// τ(r) = τ0 + k·r from their nearest previous neighbour (KD-tree) are flagged — but only where
+// the previous sweep saw through that place (its range in that direction, seen from its own
+// viewpoint, is longer): structure that was merely hidden before (disocclusion) is not moving.
+// The current non-ground points are clustered (Euclidean, on a voxel grid) and whole clusters
+// with enough flagged points are removed.
 struct DynamicFilterOptions {
   double tau0_m = 0.15;                 ///< τ0 [m]
   double tau_per_range = 0.008;         ///< k [m/m]: beam spacing grows with range
@@ -23,6 +26,10 @@ struct DynamicFilterOptions {
   int min_flagged_points = 6;           ///< a dynamic cluster has at least this many flagged
   double min_flagged_fraction = 0.12;   ///< ... and at least this share of its points flagged
   double max_cluster_extent_m = 14.0;   ///< larger clusters are structure, never removed [m]
+  double visibility_margin_m = 0.3;     ///< previous range must exceed ours by this (+2 %) [m]
+  // Slow movers (pedestrians) shift less than τ between adjacent sweeps; a second, older
+  // reference sweep this far back, compared with the visibility check, catches them [s].
+  double long_baseline_s = 0.3;
 
   Status Validate() const;
 };
@@ -35,12 +42,20 @@ struct DynamicFilterResult {
   int removed_points = 0;
 };
 
-// `current` and `previous_in_current` are de-skewed; the previous sweep is expressed in the
-// current sweep's frame. Ground masks (1 = ground) exclude ground from both; either may be empty.
+// An earlier sweep to compare with: de-skewed points in its own frame, its ground mask (may be
+// empty) and its pose in the current sweep's frame. The adjacent sweep is compared without the
+// visibility check (fast movers), older ones with it.
+struct ReferenceSweep {
+  const std::vector<Eigen::Vector3d>* points = nullptr;
+  const std::vector<uint8_t>* ground = nullptr;
+  Rigid3d T_current_reference = Rigid3d::Identity();
+  bool check_visibility = false;
+};
+
+// `current` is de-skewed; a point is flagged when any reference flags it.
 DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& current,
                                         const std::vector<uint8_t>& current_ground,
-                                        const std::vector<Eigen::Vector3d>& previous_in_current,
-                                        const std::vector<uint8_t>& previous_ground,
+                                        const std::vector<ReferenceSweep>& references,
                                         const DynamicFilterOptions& options);
 
 }  // namespace stcalib

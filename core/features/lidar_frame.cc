@@ -1,5 +1,7 @@
 #include "core/features/lidar_frame.h"
 
+#include <map>
+
 #include <glog/logging.h>
 
 namespace stcalib {
@@ -10,58 +12,118 @@ Status LidarFeatureOptions::Validate() const {
   return dynamic.Validate();
 }
 
-LidarFrameFeatures ComputeLidarFrameFeatures(const LidarScan& scan, double stamp_s,
-                                             double sweep_duration_s,
-                                             const LidarPoseFunction& T_world_lidar,
-                                             const LidarFrameFeatures* previous,
-                                             const Rigid3d& T_current_previous,
-                                             const LidarFeatureOptions& options) {
+LidarFrameFeatures ComputeLidarSweepBase(LidarScan scan, double stamp_s, double sweep_duration_s,
+                                         const LidarPoseFunction& T_world_lidar,
+                                         const LidarFeatureOptions& options) {
   LidarFrameFeatures f;
+  f.scan = std::move(scan);
   f.stamp_s = stamp_s;
-  f.rings = SplitIntoRings(scan.points_lidar);
+  f.rings = SplitIntoRings(f.scan.points_lidar);
   f.point_time_s = PointTimesFromAzimuth(f.rings, sweep_duration_s);
-  f.deskewed = DeskewToStamp(scan.points_lidar, f.point_time_s, stamp_s, T_world_lidar);
+  f.deskewed = DeskewToStamp(f.scan.points_lidar, f.point_time_s, stamp_s, T_world_lidar);
   f.ground_plane = FitGroundPlane(f.deskewed, options.ground);
   f.ground = GroundMask(f.deskewed, f.ground_plane, options.ground.band_m);
+  return f;
+}
 
-  std::vector<PointUse> use(scan.size(), PointUse::kUse);
-  for (size_t i = 0; i < scan.size(); ++i) {
-    if (f.ground[i]) use[i] = PointUse::kGround;
+void FinishLidarFrameFeatures(const std::vector<ReferenceFeatures>& references,
+                              const LidarFeatureOptions& options, LidarFrameFeatures* f) {
+  const size_t n = f->scan.size();
+  std::vector<PointUse> use(n, PointUse::kUse);
+  for (size_t i = 0; i < n; ++i) {
+    if (f->ground[i]) use[i] = PointUse::kGround;
   }
-  if (previous != nullptr && options.remove_dynamic) {
-    std::vector<Eigen::Vector3d> previous_in_current(previous->deskewed.size());
-    for (size_t i = 0; i < previous_in_current.size(); ++i) {
-      previous_in_current[i] = T_current_previous * previous->deskewed[i];
+  f->dynamic = DynamicFilterResult();
+  if (options.remove_dynamic && !references.empty()) {
+    std::vector<ReferenceSweep> sweeps;
+    for (const ReferenceFeatures& r : references) {
+      ReferenceSweep sweep;
+      sweep.points = &r.features->deskewed;
+      sweep.ground = &r.features->ground;
+      sweep.T_current_reference = r.T_current_reference;
+      sweep.check_visibility = r.check_visibility;
+      sweeps.push_back(sweep);
     }
-    f.dynamic = DetectDynamicPoints(f.deskewed, f.ground, previous_in_current, previous->ground,
-                                    options.dynamic);
-    for (size_t i = 0; i < scan.size(); ++i) {
-      if (f.dynamic.dynamic[i]) use[i] = PointUse::kDynamic;
+    f->dynamic = DetectDynamicPoints(f->deskewed, f->ground, sweeps, options.dynamic);
+    for (size_t i = 0; i < n; ++i) {
+      if (f->dynamic.dynamic[i]) use[i] = PointUse::kDynamic;
     }
   }
-  f.edges = ExtractLidarEdges(scan, f.rings, f.point_time_s, &use, options.edges);
-  for (size_t k = 0; k < f.edges.size(); ++k) {
-    f.edges.points_lidar[k] = f.deskewed[f.edges.source_index[k]];
+  f->edges = ExtractLidarEdges(f->scan, f->rings, f->point_time_s, &use, options.edges);
+  for (size_t k = 0; k < f->edges.size(); ++k) {
+    // Keep the bisector placement of the edge point, moved to the stamp like its source.
+    const int i = f->edges.source_index[k];
+    f->edges.points_lidar[k] = f->deskewed[i] + (f->edges.points_lidar[k] - f->scan.points_lidar[i]);
   }
+}
+
+LidarFrameFeatures ComputeLidarFrameFeatures(LidarScan scan, double stamp_s,
+                                             double sweep_duration_s,
+                                             const LidarPoseFunction& T_world_lidar,
+                                             const std::vector<ReferenceFeatures>& references,
+                                             const LidarFeatureOptions& options) {
+  LidarFrameFeatures f =
+      ComputeLidarSweepBase(std::move(scan), stamp_s, sweep_duration_s, T_world_lidar, options);
+  FinishLidarFrameFeatures(references, options, &f);
   return f;
 }
 
 namespace {
 
-Status LoadBase(const Drive& drive, const DriveMotion& motion, size_t frame, double sweep_s,
-                const LidarFeatureOptions& options, const LidarFrameFeatures* previous,
-                LidarFrameFeatures* out) {
-  LidarScan scan;
-  STCALIB_RETURN_IF_ERROR(drive.LoadScan(frame, &scan));
-  if (scan.size() == 0) LOG(WARNING) << drive.VelodynePath(frame) << ": empty sweep";
-  const double stamp = motion.Seconds(drive.lidar_stamps_ns[frame]);
-  const Rigid3d T_current_previous =
-      previous == nullptr ? Rigid3d::Identity()
-                          : RelativeLidarPose(motion.PoseFunction(), stamp, previous->stamp_s);
-  *out = ComputeLidarFrameFeatures(scan, stamp, sweep_s, motion.PoseFunction(), previous,
-                                   T_current_previous, options);
-  return Status::Ok();
-}
+// Base features of drive frames, computed once each.
+class BaseCache {
+ public:
+  BaseCache(const Drive& drive, const DriveMotion& motion, const LidarFeatureOptions& options)
+      : drive_(drive), motion_(motion), options_(options), sweep_s_(SweepDurationSeconds(drive)) {}
+
+  Status Get(size_t frame, const LidarFrameFeatures** features) {
+    auto it = cache_.find(frame);
+    if (it == cache_.end()) {
+      LidarScan scan;
+      STCALIB_RETURN_IF_ERROR(drive_.LoadScan(frame, &scan));
+      if (scan.size() == 0) LOG(WARNING) << drive_.VelodynePath(frame) << ": empty sweep";
+      const double stamp = motion_.Seconds(drive_.lidar_stamps_ns[frame]);
+      it = cache_.emplace(frame, ComputeLidarSweepBase(std::move(scan), stamp, sweep_s_,
+                                                       motion_.PoseFunction(), options_))
+               .first;
+    }
+    *features = &it->second;
+    return Status::Ok();
+  }
+
+  // References of `frame`: the previous sweep, and the one long_baseline_s back.
+  Status References(size_t frame, std::vector<ReferenceFeatures>* references) {
+    references->clear();
+    if (!options_.remove_dynamic || frame == 0) return Status::Ok();
+    const double period = drive_.NumFrames() > 1
+                              ? NsToSeconds(drive_.lidar_stamps_ns.back() - drive_.lidar_stamps_ns.front()) /
+                                    (drive_.NumFrames() - 1)
+                              : 0.1;
+    const size_t back = std::max<size_t>(
+        1, static_cast<size_t>(std::lround(options_.dynamic.long_baseline_s / std::max(period, 1e-3))));
+    const LidarFrameFeatures* current;
+    STCALIB_RETURN_IF_ERROR(Get(frame, &current));
+    for (size_t gap : {size_t{1}, back}) {
+      if (gap > frame || (gap == back && back == 1 && !references->empty())) continue;
+      const LidarFrameFeatures* reference;
+      STCALIB_RETURN_IF_ERROR(Get(frame - gap, &reference));
+      ReferenceFeatures r;
+      r.features = reference;
+      r.T_current_reference =
+          RelativeLidarPose(motion_.PoseFunction(), current->stamp_s, reference->stamp_s);
+      r.check_visibility = gap > 1;
+      references->push_back(r);
+    }
+    return Status::Ok();
+  }
+
+ private:
+  const Drive& drive_;
+  const DriveMotion& motion_;
+  const LidarFeatureOptions& options_;
+  double sweep_s_;
+  std::map<size_t, LidarFrameFeatures> cache_;
+};
 
 }  // namespace
 
@@ -69,15 +131,14 @@ Status LoadLidarFrameFeatures(const Drive& drive, const DriveMotion& motion, siz
                               const LidarFeatureOptions& options, LidarFrameFeatures* features) {
   STCALIB_RETURN_IF_ERROR(options.Validate());
   STCALIB_RETURN_IF_ERROR(drive.CheckFrame(frame));
-  const double sweep_s = SweepDurationSeconds(drive);
-  if (frame == 0 || !options.remove_dynamic) {
-    return LoadBase(drive, motion, frame, sweep_s, options, nullptr, features);
-  }
-  LidarFeatureOptions base = options;
-  base.remove_dynamic = false;
-  LidarFrameFeatures previous;
-  STCALIB_RETURN_IF_ERROR(LoadBase(drive, motion, frame - 1, sweep_s, base, nullptr, &previous));
-  return LoadBase(drive, motion, frame, sweep_s, options, &previous, features);
+  BaseCache cache(drive, motion, options);
+  std::vector<ReferenceFeatures> references;
+  STCALIB_RETURN_IF_ERROR(cache.References(frame, &references));
+  const LidarFrameFeatures* base;
+  STCALIB_RETURN_IF_ERROR(cache.Get(frame, &base));
+  *features = *base;
+  FinishLidarFrameFeatures(references, options, features);
+  return Status::Ok();
 }
 
 LidarEdges MergeEdges(const LidarEdges& current,
@@ -101,26 +162,18 @@ Status BuildLocalMap(const Drive& drive, const DriveMotion& motion, size_t frame
   STCALIB_RETURN_IF_ERROR(drive.CheckFrame(frame));
   if (map_options.sweeps < 1) return Status::Error("local map: sweeps must be >= 1");
   *stats = LocalMapStats();
-  const double sweep_s = SweepDurationSeconds(drive);
   const size_t first = frame + 1 >= static_cast<size_t>(map_options.sweeps)
                            ? frame + 1 - map_options.sweeps
                            : 0;
-  // Sweeps first-1 .. frame; each sweep's dynamic filter uses the one before it.
-  LidarFeatureOptions base = options;
-  base.remove_dynamic = false;
+  BaseCache cache(drive, motion, options);
   std::vector<LidarFrameFeatures> sweeps;
-  LidarFrameFeatures before;
-  const bool have_before = first > 0 && options.remove_dynamic;
-  if (have_before) {
-    STCALIB_RETURN_IF_ERROR(LoadBase(drive, motion, first - 1, sweep_s, base, nullptr, &before));
-  }
   for (size_t k = first; k <= frame; ++k) {
-    const LidarFrameFeatures* previous =
-        k == first ? (have_before ? &before : nullptr) : &sweeps.back();
-    LidarFrameFeatures f;
-    STCALIB_RETURN_IF_ERROR(LoadBase(drive, motion, k, sweep_s,
-                                     previous != nullptr ? options : base, previous, &f));
-    sweeps.push_back(std::move(f));
+    std::vector<ReferenceFeatures> references;
+    STCALIB_RETURN_IF_ERROR(cache.References(k, &references));
+    const LidarFrameFeatures* base;
+    STCALIB_RETURN_IF_ERROR(cache.Get(k, &base));
+    sweeps.push_back(*base);
+    FinishLidarFrameFeatures(references, options, &sweeps.back());
   }
   const LidarFrameFeatures& current = sweeps.back();
   std::vector<std::pair<const LidarEdges*, Rigid3d>> previous;
@@ -137,7 +190,8 @@ Status BuildLocalMap(const Drive& drive, const DriveMotion& motion, size_t frame
       RegistrationResult result;
       STCALIB_RETURN_IF_ERROR(RegisterNdt(source, target, T, map_options.ndt, &result));
       stats->ndt_iterations.push_back(result.iterations);
-      stats->ndt_correction_m.push_back((result.T_target_source.translation() - T.translation()).norm());
+      stats->ndt_correction_m.push_back(
+          (result.T_target_source.translation() - T.translation()).norm());
       T = result.T_target_source;
     }
     previous.emplace_back(&sweeps[k].edges, T);

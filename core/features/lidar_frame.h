@@ -16,13 +16,14 @@ struct LidarFeatureOptions {
   GroundOptions ground;
   LidarEdgeOptions edges;
   DynamicFilterOptions dynamic;
-  bool remove_dynamic = true;  ///< run the dynamic filter against the previous sweep
+  bool remove_dynamic = true;  ///< run the dynamic filter against earlier sweeps
 
   Status Validate() const;
 };
 
 // Everything the calibrator needs from one sweep, in the LiDAR frame at the sweep stamp.
 struct LidarFrameFeatures {
+  LidarScan scan;                          ///< as read (scan order, capture-time geometry)
   double stamp_s = 0;                      ///< LiDAR stamp, DriveMotion seconds
   ScanRings rings;
   std::vector<double> point_time_s;        ///< capture time of each point relative to the stamp
@@ -33,16 +34,32 @@ struct LidarFrameFeatures {
   LidarEdges edges;  ///< de-skewed to the stamp; time_s keeps each point's capture offset
 };
 
-// One sweep: rings, per-point times, de-skew, ground, dynamic filter (when `previous` is given:
-// the previous sweep's features and its pose in this sweep's frame), edges.
-LidarFrameFeatures ComputeLidarFrameFeatures(const LidarScan& scan, double stamp_s,
+// The first stage of a sweep: rings, per-point times, de-skew and ground. No edges yet.
+LidarFrameFeatures ComputeLidarSweepBase(LidarScan scan, double stamp_s, double sweep_duration_s,
+                                         const LidarPoseFunction& T_world_lidar,
+                                         const LidarFeatureOptions& options);
+
+// An earlier sweep for the dynamic filter, with its pose in the current sweep's frame.
+struct ReferenceFeatures {
+  const LidarFrameFeatures* features = nullptr;
+  Rigid3d T_current_reference = Rigid3d::Identity();
+  bool check_visibility = false;
+};
+
+// The second stage: the dynamic filter against `references` (when enabled and not empty), then
+// the edges, which skip ground and dynamic points.
+void FinishLidarFrameFeatures(const std::vector<ReferenceFeatures>& references,
+                              const LidarFeatureOptions& options, LidarFrameFeatures* features);
+
+// Both stages in one call.
+LidarFrameFeatures ComputeLidarFrameFeatures(LidarScan scan, double stamp_s,
                                              double sweep_duration_s,
                                              const LidarPoseFunction& T_world_lidar,
-                                             const LidarFrameFeatures* previous,
-                                             const Rigid3d& T_current_previous,
+                                             const std::vector<ReferenceFeatures>& references,
                                              const LidarFeatureOptions& options);
 
-// Loads frame `frame` of a drive (and frame − 1 for the dynamic filter) and computes its features.
+// Loads frame `frame` of a drive and computes its features; the dynamic filter compares with
+// the previous sweep and with the sweep DynamicFilterOptions::long_baseline_s earlier.
 Status LoadLidarFrameFeatures(const Drive& drive, const DriveMotion& motion, size_t frame,
                               const LidarFeatureOptions& options, LidarFrameFeatures* features);
 

@@ -18,8 +18,11 @@ std::vector<Eigen::Vector3d> DeskewToStamp(const std::vector<Eigen::Vector3d>& p
   const double width = hi > lo ? (hi - lo) / (bins - 1) : 1.0;
   for (int k = 0; k < bins; ++k) table[k] = T_stamp_inv * T_world_lidar(stamp_s + lo + k * width);
   for (size_t i = 0; i < points.size(); ++i) {
-    const int k = std::clamp(static_cast<int>(std::lround((time_s[i] - lo) / width)), 0, bins - 1);
-    out[i] = table[k] * points[i];
+    // Linear interpolation between the two tabulated poses around t_i.
+    const double f = std::clamp((time_s[i] - lo) / width, 0.0, static_cast<double>(bins - 1));
+    const int k = std::min(static_cast<int>(f), bins - 2);
+    const double w = f - k;
+    out[i] = (1 - w) * (table[k] * points[i]) + w * (table[k + 1] * points[i]);
   }
   return out;
 }

@@ -1,0 +1,177 @@
+// Dynamic-point removal, the oxts motion model, de-skew and the local map (issue 4).
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include "core/features/lidar_frame.h"
+#include "core/motion/deskew.h"
+#include "core/motion/drive_motion.h"
+#include "core/motion/oxts_trajectory.h"
+#include "core/score/alignment.h"
+#include "core/sim/simulator.h"
+#include "core/types/calibration.h"
+#include "test/test_util.h"
+
+namespace stcalib {
+namespace {
+
+using sim::Simulator;
+using sim::SimulatorOptions;
+
+// The LiDAR pose from the simulated oxts packets (what a real drive offers), in sim seconds.
+struct OxtsMotion {
+  explicit OxtsMotion(const Simulator& s) : sim(s) {
+    std::vector<OxtsPacket> packets;
+    std::vector<StampNs> stamps;
+    for (int i = 0; i < s.options().frames; ++i) {
+      packets.push_back(s.SimulateOxts(i));
+      stamps.push_back(s.Timing(i).oxts_stamp_ns);
+    }
+    EXPECT_TRUE(OxtsTrajectory::Create(packets, stamps, &trajectory).ok());
+  }
+  Rigid3d operator()(double t_sim) const {
+    return trajectory.T_world_imu(sim.start_stamp_ns() + SecondsToNs(t_sim)) *
+           sim.T_lidar_imu().inverse();
+  }
+  const Simulator& sim;
+  OxtsTrajectory trajectory;
+};
+
+TEST(OxtsTrajectory, RelativePosesMatchTheSimulatedTruth) {
+  SimulatorOptions options;
+  options.seed = 21;
+  options.frames = 30;
+  const Simulator s(options);
+  const OxtsMotion motion(s);
+  for (double t : {0.3, 1.234, 2.05, 2.9}) {
+    for (double dt : {0.0105, 0.05, 0.1, -0.1}) {
+      const Rigid3d truth = s.trajectory().T_world_imu(t).inverse() * s.trajectory().T_world_imu(t + dt);
+      const Rigid3d estimate = (motion(t) * s.T_lidar_imu()).inverse() * (motion(t + dt) * s.T_lidar_imu());
+      // Within the simulated GPS/INS noise (1 cm position, 0.01° attitude per packet).
+      EXPECT_LT((estimate.translation() - truth.translation()).norm(), 0.05) << t << " " << dt;
+      EXPECT_LT(RotationErrorDeg(estimate.linear(), truth.linear()), 0.1) << t << " " << dt;
+    }
+  }
+}
+
+TEST(OxtsTrajectory, RejectsBadStamps) {
+  std::vector<OxtsPacket> packets(3);
+  OxtsTrajectory trajectory;
+  EXPECT_FALSE(OxtsTrajectory::Create(packets, {1, 2, 2}, &trajectory).ok());
+  EXPECT_FALSE(OxtsTrajectory::Create(packets, {3, 2, 4}, &trajectory).ok());
+  EXPECT_FALSE(OxtsTrajectory::Create(packets, {1, 2}, &trajectory).ok());
+  EXPECT_FALSE(OxtsTrajectory::Create({}, {}, &trajectory).ok());
+  EXPECT_TRUE(OxtsTrajectory::Create(packets, {1, 2, 3}, &trajectory).ok());
+}
+
+TEST(Deskew, PureTranslationMovesEachPointByItsOwnTime) {
+  // The LiDAR moves along x at 10 m/s: a point captured 0.05 s after the stamp moves +0.5 m.
+  const LidarPoseFunction pose = [](double t) {
+    return MakeRigid(Eigen::Matrix3d::Identity(), Eigen::Vector3d(10.0 * t, 0, 0));
+  };
+  const std::vector<Eigen::Vector3d> points = {{5, 0, 0}, {5, 1, 0}, {-3, 2, 1}};
+  const std::vector<double> times = {-0.05, 0.0, 0.05};
+  const auto out = DeskewToStamp(points, times, 1.0, pose);
+  EXPECT_NEAR(out[0].x(), 4.5, 1e-3);
+  EXPECT_NEAR(out[1].x(), 5.0, 1e-3);
+  EXPECT_NEAR(out[2].x(), -2.5, 1e-3);
+  EXPECT_NEAR(out[2].z(), 1.0, 1e-12);
+}
+
+struct DynamicCounts {
+  size_t dynamic = 0, dynamic_removed = 0, static_points = 0, static_removed = 0;
+};
+
+TEST(DynamicFilter, RemovesMovingObjectsAndKeepsStructure) {
+  DynamicCounts total;
+  for (uint64_t seed : {1u, 2u, 9u}) {
+    SimulatorOptions options;
+    options.seed = seed;
+    options.frames = 30;
+    const Simulator s(options);
+    const OxtsMotion motion(s);
+    const LidarFeatureOptions feature_options;
+    for (int frame : {3, 14, 27}) {
+      // The adjacent sweep and the one 0.3 s back, as LoadLidarFrameFeatures picks them.
+      std::vector<LidarFrameFeatures> bases;
+      std::vector<ReferenceFeatures> references;
+      const double t = s.LidarMidTime(frame);
+      for (int gap : {1, 3}) {
+        bases.push_back(ComputeLidarSweepBase(s.SimulateSweep(frame - gap).scan,
+                                              s.LidarMidTime(frame - gap), s.SweepDuration(),
+                                              motion, feature_options));
+      }
+      for (int k = 0; k < 2; ++k) {
+        ReferenceFeatures r;
+        r.features = &bases[k];
+        r.T_current_reference = RelativeLidarPose(motion, t, bases[k].stamp_s);
+        r.check_visibility = k == 1;
+        references.push_back(r);
+      }
+      const sim::SimulatedSweep sweep = s.SimulateSweep(frame);
+      const LidarFrameFeatures f = ComputeLidarFrameFeatures(
+          sweep.scan, t, s.SweepDuration(), motion, references, feature_options);
+      DynamicCounts c;
+      for (size_t i = 0; i < sweep.scan.size(); ++i) {
+        if (sweep.labels[i] == static_cast<uint8_t>(PointLabel::kDynamic)) {
+          ++c.dynamic;
+          c.dynamic_removed += f.dynamic.dynamic[i];
+        } else if (sweep.labels[i] == static_cast<uint8_t>(PointLabel::kStatic)) {
+          ++c.static_points;
+          c.static_removed += f.dynamic.dynamic[i];
+        }
+      }
+      std::printf("seed %llu frame %d: dynamic %zu, removed %.1f%%; static %zu, removed %.2f%%\n",
+                  static_cast<unsigned long long>(seed), frame, c.dynamic,
+                  100.0 * c.dynamic_removed / std::max<size_t>(c.dynamic, 1), c.static_points,
+                  100.0 * c.static_removed / c.static_points);
+      total.dynamic += c.dynamic;
+      total.dynamic_removed += c.dynamic_removed;
+      total.static_points += c.static_points;
+      total.static_removed += c.static_removed;
+    }
+  }
+  const double dynamic_rate = static_cast<double>(total.dynamic_removed) / total.dynamic;
+  const double static_rate = static_cast<double>(total.static_removed) / total.static_points;
+  std::printf("total: %.1f%% of %zu dynamic points removed, %.2f%% of %zu static points\n",
+              100 * dynamic_rate, total.dynamic, 100 * static_rate, total.static_points);
+  EXPECT_GT(total.dynamic, 2000u);
+  EXPECT_GE(dynamic_rate, 0.90);
+  EXPECT_LE(static_rate, 0.03);
+}
+
+TEST(LocalMap, KittiMapOfThreeSweepsWithOxtsAndNdt) {
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  DriveMotion motion;
+  ASSERT_TRUE(DriveMotion::Create(drive, &motion).ok());
+  LidarFrameFeatures single;
+  ASSERT_TRUE(LoadLidarFrameFeatures(drive, motion, 12, LidarFeatureOptions(), &single).ok());
+  LidarEdges oxts_map, ndt_map;
+  LocalMapStats oxts_stats, ndt_stats;
+  LocalMapOptions map_options;
+  ASSERT_TRUE(BuildLocalMap(drive, motion, 12, LidarFeatureOptions(), map_options, &oxts_map,
+                            &oxts_stats).ok());
+  map_options.use_ndt = true;
+  ASSERT_TRUE(BuildLocalMap(drive, motion, 12, LidarFeatureOptions(), map_options, &ndt_map,
+                            &ndt_stats).ok());
+  EXPECT_EQ(oxts_stats.sweeps_used, 3);
+  EXPECT_GT(oxts_map.size(), 2.5 * single.edges.size());
+  ASSERT_EQ(ndt_stats.ndt_iterations.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    std::printf("NDT sweep %zu: %d iterations, %.3f m from the oxts pose\n", k,
+                ndt_stats.ndt_iterations[k], ndt_stats.ndt_correction_m[k]);
+    EXPECT_LT(ndt_stats.ndt_correction_m[k], 0.3);  // oxts poses are good to decimetres
+  }
+  // With the first sweep alone (frame 0) the map is just that sweep.
+  LidarEdges first;
+  map_options.use_ndt = false;
+  ASSERT_TRUE(BuildLocalMap(drive, motion, 0, LidarFeatureOptions(), map_options, &first,
+                            &oxts_stats).ok());
+  EXPECT_EQ(oxts_stats.sweeps_used, 1);
+}
+
+}  // namespace
+}  // namespace stcalib
