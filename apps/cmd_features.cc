@@ -1,7 +1,6 @@
 // stcalib features: the line features of one frame, as pictures and numbers.
 #include <cstdio>
 #include <filesystem>
-
 #include <opencv2/imgproc.hpp>
 
 #include "apps/commands.h"
@@ -25,8 +24,9 @@ cv::Mat Colourise(const cv::Mat& map_0_255) {
 
 void Draw(cv::Mat* canvas, const std::vector<ProjectedPoint>& points, const cv::Scalar& colour) {
   for (const ProjectedPoint& p : points) {
-    cv::circle(*canvas, cv::Point(static_cast<int>(std::lround(p.pixel.x())),
-                                  static_cast<int>(std::lround(p.pixel.y()))),
+    cv::circle(*canvas,
+               cv::Point(static_cast<int>(std::lround(p.pixel.x())),
+                         static_cast<int>(std::lround(p.pixel.y()))),
                2, colour, cv::FILLED);
   }
 }
@@ -60,6 +60,8 @@ int RunFeatures() {
   }
   image_options.min_segment_length_px = FLAGS_min_segment_px;
   image_options.max_edge_density = FLAGS_max_edge_density;
+  image_options.split_orientation = true;
+  image_options.precise_distance = true;
   const ImageFeatures image_features = ExtractImageFeatures(image, image_options);
   LidarFrameFeatures lidar;
   status = LoadLidarFrameFeatures(drive, motion, frame, LidarFeatureOptions(), &lidar);
@@ -79,32 +81,33 @@ int RunFeatures() {
         .push_back(lidar.edges.points_lidar[i]);
   }
   for (size_t i = 0; i < lidar.deskewed.size(); ++i) {
-    if (!lidar.dynamic.dynamic.empty() && lidar.dynamic.dynamic[i]) dynamic.push_back(lidar.deskewed[i]);
+    if (!lidar.dynamic.dynamic.empty() && lidar.dynamic.dynamic[i])
+      dynamic.push_back(lidar.deskewed[i]);
   }
   const auto projected_v = ProjectPoints(camera, T_camera_lidar, vertical);
   const auto projected_h = ProjectPoints(camera, T_camera_lidar, horizontal);
   const auto projected_d = ProjectPoints(camera, T_camera_lidar, dynamic);
   std::vector<ProjectedPoint> all = projected_v;
   all.insert(all.end(), projected_h.begin(), projected_h.end());
-  const AlignmentStats alignment =
-      MeasureAlignment(all, image_features.distance_raw_px, 3.0, 8.0);
+  const AlignmentStats alignment = MeasureAlignment(all, image_features.distance_raw_px, 3.0, 8.0);
 
   cv::Mat overlay;
   image.convertTo(overlay, CV_8UC3, 0.5);
-  Draw(&overlay, projected_d, cv::Scalar(255, 0, 255));   // removed dynamic points: magenta
-  Draw(&overlay, projected_v, cv::Scalar(80, 255, 80));   // vertical edges: green
-  Draw(&overlay, projected_h, cv::Scalar(0, 170, 255));   // horizontal edges: orange
+  Draw(&overlay, projected_d, cv::Scalar(255, 0, 255));  // removed dynamic points: magenta
+  Draw(&overlay, projected_v, cv::Scalar(80, 255, 80));  // vertical edges: green
+  Draw(&overlay, projected_h, cv::Scalar(0, 170, 255));  // horizontal edges: orange
   // Edge mask with the projected LiDAR edges: green within 3 px of an edge, red beyond.
   cv::Mat check;
   cv::cvtColor(image_features.edge_mask / 2, check, cv::COLOR_GRAY2BGR);
   for (const ProjectedPoint& p : all) {
-    const int u = static_cast<int>(std::lround(p.pixel.x())), v = static_cast<int>(std::lround(p.pixel.y()));
+    const int u = static_cast<int>(std::lround(p.pixel.x())),
+              v = static_cast<int>(std::lround(p.pixel.y()));
     const bool near = image_features.distance_raw_px.at<float>(v, u) <= 3.0f;
-    cv::circle(check, cv::Point(u, v), 2, near ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255), cv::FILLED);
+    cv::circle(check, cv::Point(u, v), 2, near ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255),
+               cv::FILLED);
   }
   const std::string out = FLAGS_out;
-  for (const auto& [name, picture] :
-       std::vector<std::pair<std::string, cv::Mat>>{
+  for (const auto& [name, picture] : std::vector<std::pair<std::string, cv::Mat>>{
            {"edge_mask.png", image_features.edge_mask},
            {"idt.png", Colourise(image_features.idt)},
            {"idt_suppressed.png", Colourise(image_features.idt_suppressed * 2.0)},
@@ -119,16 +122,18 @@ int RunFeatures() {
   int ground = 0;
   for (uint8_t g : lidar.ground) ground += g;
   std::printf("  lidar      %zu points, %d rings, %d ground, %d dynamic removed (%d clusters)\n",
-              lidar.deskewed.size(), lidar.rings.num_rings(), ground,
-              lidar.dynamic.removed_points, lidar.dynamic.dynamic_clusters);
+              lidar.deskewed.size(), lidar.rings.num_rings(), ground, lidar.dynamic.removed_points,
+              lidar.dynamic.dynamic_clusters);
   std::printf("  edges      %zu vertical, %zu horizontal; %zu + %zu in the image\n",
               vertical.size(), horizontal.size(), projected_v.size(), projected_h.size());
-  std::printf("  alignment  %.1f%% of %d projected edge points within 3 px of an image edge "
-              "(median %.2f px)\n",
-              100 * alignment.rate, alignment.kept, alignment.median_distance_px);
+  std::printf(
+      "  alignment  %.1f%% of %d projected edge points within 3 px of an image edge "
+      "(median %.2f px)\n",
+      100 * alignment.rate, alignment.kept, alignment.median_distance_px);
   std::printf("  oriented   %.1f%% within 3 px of an image edge of the same orientation\n",
               100 * oriented.rate);
-  std::printf("  wrote      %s/{edge_mask,idt,idt_suppressed,lidar_edges,alignment}.png\n", out.c_str());
+  std::printf("  wrote      %s/{edge_mask,idt,idt_suppressed,lidar_edges,alignment}.png\n",
+              out.c_str());
   return kExitOk;
 }
 

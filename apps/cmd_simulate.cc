@@ -17,26 +17,28 @@ int RunSimulate() {
   options.dynamic_objects = FLAGS_dynamic_objects;
   options.lidar_hz = FLAGS_lidar_hz;
   if (!sim::ParseSceneType(FLAGS_scene, &options.scene)) {
-    return UsageError("simulate", "--scene must be urban, poles or open, got '" + FLAGS_scene + "'");
+    return UsageError("simulate",
+                      "--scene must be urban, poles or open, got '" + FLAGS_scene + "'");
   }
   const Status valid = options.Validate();
   if (!valid.ok()) return UsageError("simulate", valid.message());
 
   const auto start = std::chrono::steady_clock::now();
   std::string drive_dir;
-  const Status status = sim::WriteSimulatedDrive(
-      options, FLAGS_out, &drive_dir, [](int done, int total) {
+  const Status status =
+      sim::WriteSimulatedDrive(options, FLAGS_out, &drive_dir, [](int done, int total) {
         std::fprintf(stderr, "\rsimulate: frame %d/%d", done, total);
         if (done == total) std::fprintf(stderr, "\n");
       });
   if (!status.ok()) return ReportError("simulate", status);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("simulated %d frames (scene %s, seed %llu, time offset %+.4f s, %d moving objects) "
-              "in %.1f s\ndrive: %s\n",
-              options.frames, sim::SceneTypeName(options.scene).c_str(),
-              static_cast<unsigned long long>(options.seed), options.time_offset_s,
-              options.dynamic_objects, seconds, drive_dir.c_str());
+  std::printf(
+      "simulated %d frames (scene %s, seed %llu, time offset %+.4f s, %d moving objects) "
+      "in %.1f s\ndrive: %s\n",
+      options.frames, sim::SceneTypeName(options.scene).c_str(),
+      static_cast<unsigned long long>(options.seed), options.time_offset_s, options.dynamic_objects,
+      seconds, drive_dir.c_str());
   return kExitOk;
 }
 

@@ -11,8 +11,8 @@ int ReportError(const std::string& command, const Status& status) {
 }
 
 int UsageError(const std::string& command, const std::string& message) {
-  std::cerr << "stcalib " << command << ": usage error: " << message
-            << "\n(run `stcalib " << command << " --help`)\n";
+  std::cerr << "stcalib " << command << ": usage error: " << message << "\n(run `stcalib "
+            << command << " --help`)\n";
   return kExitUsage;
 }
 

@@ -1,11 +1,11 @@
 // stcalib: targetless, online LiDAR–camera calibration of rotation, translation and time offset.
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
 #include <cstring>
 #include <iostream>
 #include <string>
 #include <vector>
-
-#include <gflags/gflags.h>
-#include <glog/logging.h>
 
 #include "apps/commands.h"
 #include "apps/flags.h"

@@ -1,7 +1,7 @@
 // Reading and projecting one KITTI frame (method.md §10: decoding a PNG ≈ 8 ms, a .bin ≈ 0.1 ms).
-#include <filesystem>
-
 #include <benchmark/benchmark.h>
+
+#include <filesystem>
 #include <opencv2/core.hpp>
 
 #include "core/io/drive.h"
@@ -57,8 +57,8 @@ void BM_ProjectFrame(benchmark::State& state) {
   if (!OpenKitti(state, &drive)) return;
   LidarScan scan;
   if (!drive.LoadScan(0, &scan).ok()) return state.SkipWithError("cannot read scan");
-  const CameraModel camera = CameraModel::FromCalibration(
-      drive.camera, drive.camera.image_width, drive.camera.image_height);
+  const CameraModel camera = CameraModel::FromCalibration(drive.camera, drive.camera.image_width,
+                                                          drive.camera.image_height);
   for (auto _ : state) {
     benchmark::DoNotOptimize(ProjectPoints(camera, drive.T_camera_lidar, scan.points_lidar));
   }

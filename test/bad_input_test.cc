@@ -1,9 +1,9 @@
 // Every kind of bad input gets a Status naming the file (and line) and the problem.
-#include <filesystem>
-#include <limits>
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <filesystem>
+#include <limits>
 
 #include "core/io/drive.h"
 #include "core/io/image.h"
@@ -21,12 +21,12 @@ using testing::MakeTinyDrive;
 using testing::ScopedTempDir;
 using testing::WriteFile;
 
-#define EXPECT_ERROR(status_expr, ...)                                   \
-  do {                                                                   \
-    const ::stcalib::Status _s = (status_expr);                          \
-    EXPECT_FALSE(_s.ok());                                               \
+#define EXPECT_ERROR(status_expr, ...)                                    \
+  do {                                                                    \
+    const ::stcalib::Status _s = (status_expr);                           \
+    EXPECT_FALSE(_s.ok());                                                \
     for (const std::string& part : std::vector<std::string>{__VA_ARGS__}) \
-      EXPECT_THAT(_s.message(), HasSubstr(part));                        \
+      EXPECT_THAT(_s.message(), HasSubstr(part));                         \
   } while (0)
 
 class BadInput : public ::testing::Test {

@@ -1,12 +1,12 @@
 // The stcalib binary end to end: exit codes and messages of info and project.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <string>
-#include <sys/wait.h>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "core/io/image.h"
 #include "test/test_util.h"
@@ -28,7 +28,8 @@ RunResult RunStcalib(const std::string& args) {
   if (pipe == nullptr) return result;
   std::array<char, 4096> buffer;
   size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), n);
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    result.output.append(buffer.data(), n);
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return result;
@@ -53,8 +54,8 @@ TEST(Cli, InfoAndProjectOnKitti) {
   EXPECT_THAT(info.output, HasSubstr("1242x375"));
   testing::ScopedTempDir tmp;
   const std::string png = tmp.path() + "/overlay.png";
-  const RunResult project = RunStcalib("project --drive=" + testing::KittiDriveDir() +
-                                " --frame=3 --out=" + png);
+  const RunResult project =
+      RunStcalib("project --drive=" + testing::KittiDriveDir() + " --frame=3 --out=" + png);
   ASSERT_EQ(project.exit_code, 0) << project.output;
   cv::Mat overlay;
   ASSERT_TRUE(ReadImage(png, &overlay).ok());
@@ -82,16 +83,16 @@ TEST(Cli, BadInputExitsNonZeroNamingTheFile) {
       RunStcalib("project --drive=" + drive + " --frame=5 --out=" + tmp.path() + "/x.png");
   EXPECT_EQ(out_of_range.exit_code, 1);
   EXPECT_THAT(out_of_range.output, HasSubstr("frame 5 out of range"));
-  const RunResult unwritable =
-      RunStcalib("project --drive=" + drive + " --frame=0 --out=" + tmp.path() + "/no/such/dir/x.png");
+  const RunResult unwritable = RunStcalib("project --drive=" + drive +
+                                          " --frame=0 --out=" + tmp.path() + "/no/such/dir/x.png");
   EXPECT_EQ(unwritable.exit_code, 1);
   EXPECT_THAT(unwritable.output, HasSubstr("no/such/dir/x.png"));
 }
 
 TEST(Cli, SimulateWritesAReadableDrive) {
   testing::ScopedTempDir tmp;
-  const RunResult sim = RunStcalib("simulate --out=" + tmp.path() +
-                                   " --frames=2 --seed=9 --time_offset_s=0.02");
+  const RunResult sim =
+      RunStcalib("simulate --out=" + tmp.path() + " --frames=2 --seed=9 --time_offset_s=0.02");
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
   const std::string drive = tmp.path() + "/2026_01_10/2026_01_10_drive_0001_sync";
   EXPECT_THAT(sim.output, HasSubstr(drive));
@@ -99,6 +100,43 @@ TEST(Cli, SimulateWritesAReadableDrive) {
   ASSERT_EQ(info.exit_code, 0) << info.output;
   EXPECT_THAT(info.output, HasSubstr("frames       2"));
   EXPECT_TRUE(std::filesystem::exists(tmp.path() + "/2026_01_10/ground_truth.json"));
+}
+
+TEST(Cli, FeaturesWritesPicturesAndNumbers) {
+  STCALIB_REQUIRE_KITTI();
+  testing::ScopedTempDir tmp;
+  const RunResult r = RunStcalib("features --drive=" + testing::KittiDriveDir() +
+                                 " --frame=4 --out=" + tmp.path() + "/f");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("64 rings"));
+  for (const char* name :
+       {"edge_mask.png", "idt.png", "idt_suppressed.png", "lidar_edges.png", "alignment.png"}) {
+    cv::Mat picture;
+    ASSERT_TRUE(ReadImage(tmp.path() + "/f/" + name, &picture).ok()) << name;
+    EXPECT_EQ(picture.cols, 1242);
+  }
+  EXPECT_EQ(RunStcalib("features --drive=" + testing::KittiDriveDir() + " --frame=4").exit_code, 2);
+  EXPECT_EQ(RunStcalib("features --drive=" + testing::KittiDriveDir() +
+                       " --frame=4 --detector=x --out=" + tmp.path())
+                .exit_code,
+            2);
+}
+
+TEST(Cli, FeaturesOnDegenerateFramesWarnsButDoesNotCrash) {
+  testing::ScopedTempDir tmp;
+  // The tiny drive: flat images (no edges) and 100 points in a line (no rings worth the name).
+  const std::string drive = testing::MakeTinyDrive(tmp.path(), 3);
+  const RunResult r =
+      RunStcalib("features --drive=" + drive + " --frame=1 --out=" + tmp.path() + "/f");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("0 edge pixels"));
+  EXPECT_THAT(r.output, HasSubstr("no edges found"));
+  // An empty sweep.
+  testing::WriteFile(drive + "/velodyne_points/data/0000000002.bin", "");
+  const RunResult empty =
+      RunStcalib("features --drive=" + drive + " --frame=2 --out=" + tmp.path() + "/g");
+  EXPECT_EQ(empty.exit_code, 0) << empty.output;
+  EXPECT_THAT(empty.output, HasSubstr("empty sweep"));
 }
 
 TEST(Cli, SimulateRejectsBadFlags) {

@@ -1,8 +1,8 @@
 // Dynamic-point removal, the oxts motion model, de-skew and the local map (issue 4).
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
-
-#include <gtest/gtest.h>
 
 #include "core/features/lidar_frame.h"
 #include "core/motion/deskew.h"
@@ -46,8 +46,10 @@ TEST(OxtsTrajectory, RelativePosesMatchTheSimulatedTruth) {
   const OxtsMotion motion(s);
   for (double t : {0.3, 1.234, 2.05, 2.9}) {
     for (double dt : {0.0105, 0.05, 0.1, -0.1}) {
-      const Rigid3d truth = s.trajectory().T_world_imu(t).inverse() * s.trajectory().T_world_imu(t + dt);
-      const Rigid3d estimate = (motion(t) * s.T_lidar_imu()).inverse() * (motion(t + dt) * s.T_lidar_imu());
+      const Rigid3d truth =
+          s.trajectory().T_world_imu(t).inverse() * s.trajectory().T_world_imu(t + dt);
+      const Rigid3d estimate =
+          (motion(t) * s.T_lidar_imu()).inverse() * (motion(t + dt) * s.T_lidar_imu());
       // Within the simulated GPS/INS noise (1 cm position, 0.01° attitude per packet).
       EXPECT_LT((estimate.translation() - truth.translation()).norm(), 0.05) << t << " " << dt;
       EXPECT_LT(RotationErrorDeg(estimate.linear(), truth.linear()), 0.1) << t << " " << dt;
@@ -110,8 +112,8 @@ TEST(DynamicFilter, RemovesMovingObjectsAndKeepsStructure) {
         references.push_back(r);
       }
       const sim::SimulatedSweep sweep = s.SimulateSweep(frame);
-      const LidarFrameFeatures f = ComputeLidarFrameFeatures(
-          sweep.scan, t, s.SweepDuration(), motion, references, feature_options);
+      const LidarFrameFeatures f = ComputeLidarFrameFeatures(sweep.scan, t, s.SweepDuration(),
+                                                             motion, references, feature_options);
       DynamicCounts c;
       for (size_t i = 0; i < sweep.scan.size(); ++i) {
         if (sweep.labels[i] == static_cast<uint8_t>(PointLabel::kDynamic)) {
@@ -152,11 +154,13 @@ TEST(LocalMap, KittiMapOfThreeSweepsWithOxtsAndNdt) {
   LidarEdges oxts_map, ndt_map;
   LocalMapStats oxts_stats, ndt_stats;
   LocalMapOptions map_options;
-  ASSERT_TRUE(BuildLocalMap(drive, motion, 12, LidarFeatureOptions(), map_options, &oxts_map,
-                            &oxts_stats).ok());
+  ASSERT_TRUE(
+      BuildLocalMap(drive, motion, 12, LidarFeatureOptions(), map_options, &oxts_map, &oxts_stats)
+          .ok());
   map_options.use_ndt = true;
-  ASSERT_TRUE(BuildLocalMap(drive, motion, 12, LidarFeatureOptions(), map_options, &ndt_map,
-                            &ndt_stats).ok());
+  ASSERT_TRUE(
+      BuildLocalMap(drive, motion, 12, LidarFeatureOptions(), map_options, &ndt_map, &ndt_stats)
+          .ok());
   EXPECT_EQ(oxts_stats.sweeps_used, 3);
   EXPECT_GT(oxts_map.size(), 2.5 * single.edges.size());
   ASSERT_EQ(ndt_stats.ndt_iterations.size(), 2u);
@@ -168,8 +172,9 @@ TEST(LocalMap, KittiMapOfThreeSweepsWithOxtsAndNdt) {
   // With the first sweep alone (frame 0) the map is just that sweep.
   LidarEdges first;
   map_options.use_ndt = false;
-  ASSERT_TRUE(BuildLocalMap(drive, motion, 0, LidarFeatureOptions(), map_options, &first,
-                            &oxts_stats).ok());
+  ASSERT_TRUE(
+      BuildLocalMap(drive, motion, 0, LidarFeatureOptions(), map_options, &first, &oxts_stats)
+          .ok());
   EXPECT_EQ(oxts_stats.sweeps_used, 1);
 }
 

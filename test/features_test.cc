@@ -1,10 +1,10 @@
 // Line features against simulated truth and the KITTI calibration (issue 4).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "core/features/ground.h"
@@ -33,6 +33,7 @@ TEST(ImageFeatures, RectangleGivesExactDistanceAndIdt) {
   cv::rectangle(image, cv::Rect(60, 40, 80, 40), cv::Scalar(255, 255, 255), cv::FILLED);
   ImageFeatureOptions options;
   options.basin_px = 10;
+  options.precise_distance = true;
   const ImageFeatures f = ExtractImageFeatures(image, options);
   ASSERT_FALSE(f.empty());
   EXPECT_EQ(f.edge_mask.size(), image.size());
@@ -52,6 +53,24 @@ TEST(ImageFeatures, RectangleGivesExactDistanceAndIdt) {
   EXPECT_EQ(f.distance_px.type(), CV_32F);
 }
 
+TEST(ImageFeatures, RegionOfInterestMatchesTheFullImageInside) {
+  cv::Mat image(120, 200, CV_8UC3, cv::Scalar(0, 0, 0));
+  cv::rectangle(image, cv::Rect(60, 60, 80, 40), cv::Scalar(255, 255, 255), cv::FILLED);
+  cv::rectangle(image, cv::Rect(20, 5, 30, 20), cv::Scalar(255, 255, 255), cv::FILLED);
+  ImageFeatureOptions options;
+  options.precise_distance = true;
+  const ImageFeatures whole = ExtractImageFeatures(image, options);
+  options.region_of_interest = cv::Rect(0, 40, 200, 80);
+  const ImageFeatures part = ExtractImageFeatures(image, options);
+  EXPECT_EQ(part.idt.size(), image.size());
+  // The upper rectangle is outside the region: no edges there.
+  EXPECT_EQ(cv::countNonZero(part.edge_mask(cv::Rect(0, 0, 200, 40))), 0);
+  EXPECT_GT(cv::countNonZero(whole.edge_mask(cv::Rect(0, 0, 200, 40))), 0);
+  // Inside, near the lower rectangle, the maps agree.
+  EXPECT_EQ(part.distance_raw_px.at<float>(80, 50), whole.distance_raw_px.at<float>(80, 50));
+  EXPECT_NEAR(part.idt.at<float>(80, 58), whole.idt.at<float>(80, 58), 1.0);
+}
+
 TEST(ImageFeatures, BlackImageGivesEmptyFeaturesNotACrash) {
   ImageFeatureOptions options;
   options.pyramid_basins_px = {40, 20};
@@ -68,7 +87,8 @@ TEST(ImageFeatures, LineDetectorsFindSegmentsOnKitti) {
   ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
   cv::Mat image;
   ASSERT_TRUE(drive.LoadImage(0, &image).ok());
-  for (auto detector : {ImageFeatureOptions::Detector::kLsd, ImageFeatureOptions::Detector::kFastLine}) {
+  for (auto detector :
+       {ImageFeatureOptions::Detector::kLsd, ImageFeatureOptions::Detector::kFastLine}) {
     ImageFeatureOptions options;
     options.detector = detector;
     options.pyramid_basins_px = {60, 30};
@@ -151,20 +171,21 @@ TEST(LidarEdges, SimulatedEdgePointsLieOnTrueGeometricEdges) {
     const Simulator s(options);
     for (int frame : {4, 15}) {
       const sim::SimulatedSweep sweep = s.SimulateSweep(frame);
-      const LidarFrameFeatures f = ComputeLidarFrameFeatures(
-          sweep.scan, s.LidarMidTime(frame), s.SweepDuration(), TruthPose(s), {},
-          LidarFeatureOptions());
+      const LidarFrameFeatures f =
+          ComputeLidarFrameFeatures(sweep.scan, s.LidarMidTime(frame), s.SweepDuration(),
+                                    TruthPose(s), {}, LidarFeatureOptions());
       ASSERT_GT(f.edges.size(), 500u);
       const double t_mid = s.LidarMidTime(frame);
       const Rigid3d T_mid = TruthPose(s)(t_mid);
-      const sim::AzimuthIndex index = s.scene().BuildIndex(
-          T_mid.translation().head<2>(), t_mid - 0.06, t_mid + 0.06, 1.5, 130);
+      const sim::AzimuthIndex index =
+          s.scene().BuildIndex(T_mid.translation().head<2>(), t_mid - 0.06, t_mid + 0.06, 1.5, 130);
       size_t frame_near = 0;
       for (size_t k = 0; k < f.edges.size(); ++k) {
         const int i = f.edges.source_index[k];
         const double t = sweep.point_time_s[i];
         const Rigid3d T = TruthPose(s)(t);
-        frame_near += NearTrueEdge(s, index, T.translation(), T * sweep.scan.points_lidar[i], t, 0.2);
+        frame_near +=
+            NearTrueEdge(s, index, T.translation(), T * sweep.scan.points_lidar[i], t, 0.2);
       }
       std::printf("seed %llu frame %d: %zu edge points, %.1f%% within 0.2 m of a true edge\n",
                   static_cast<unsigned long long>(seed), frame, f.edges.size(),
@@ -187,7 +208,8 @@ TEST(Ground, PlaneSeparatesSimulatedGroundLabels) {
   ASSERT_TRUE(plane.valid);
   // The LiDAR is 1.73 m above the road (0.93 m IMU height + 0.80 m).
   EXPECT_NEAR(plane.offset, 1.73, 0.1);
-  const std::vector<uint8_t> mask = GroundMask(sweep.scan.points_lidar, plane, ground_options.band_m);
+  const std::vector<uint8_t> mask =
+      GroundMask(sweep.scan.points_lidar, plane, ground_options.band_m);
   size_t true_positive = 0, labelled = 0, masked = 0;
   for (size_t i = 0; i < mask.size(); ++i) {
     const bool ground = sweep.labels[i] == static_cast<uint8_t>(PointLabel::kGround);
@@ -201,8 +223,8 @@ TEST(Ground, PlaneSeparatesSimulatedGroundLabels) {
 }
 
 TEST(ProjectionFilter, DropsIsolatedPointsOnly) {
-  const std::vector<Eigen::Vector2d> pixels = {
-      {10, 10}, {15, 14}, {100, 100}, {300, 40}, {307.9, 40}, {500, 500}};
+  const std::vector<Eigen::Vector2d> pixels = {{10, 10},  {15, 14},    {100, 100},
+                                               {300, 40}, {307.9, 40}, {500, 500}};
   const std::vector<bool> keep = KeepNonIsolated(pixels, 8.0);
   EXPECT_THAT(keep, ::testing::ElementsAre(true, true, false, true, true, false));
   EXPECT_THAT(KeepNonIsolated({{1, 1}}, 8.0), ::testing::ElementsAre(false));
@@ -237,7 +259,9 @@ TEST(Alignment, KittiRateDropsWithTwoDegreesOfError) {
   ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
   DriveMotion motion;
   ASSERT_TRUE(DriveMotion::Create(drive, &motion).ok());
-  const ImageFeatureOptions image_options;
+  ImageFeatureOptions image_options;
+  image_options.split_orientation = true;
+  image_options.precise_distance = true;
   const std::vector<size_t> frames = {0, 7, 14, 21, 29};
   const char* kAxis[] = {"roll", "pitch", "yaw"};
   double plain_true = 0, oriented_true = 0;
@@ -252,7 +276,8 @@ TEST(Alignment, KittiRateDropsWithTwoDegreesOfError) {
     const Rigid3d T_motion = RelativeLidarPose(
         motion.PoseFunction(), motion.Seconds(drive.camera_stamps_ns[frame]), lidar.stamp_s);
     auto rates = [&](const Rigid3d& T_camera_lidar) {
-      const auto projected = ProjectPoints(camera, T_camera_lidar * T_motion, lidar.edges.points_lidar);
+      const auto projected =
+          ProjectPoints(camera, T_camera_lidar * T_motion, lidar.edges.points_lidar);
       return Eigen::Vector2d(
           MeasureAlignment(projected, image_features.distance_raw_px, 3.0, 8.0).rate,
           MeasureOrientedAlignment(projected, lidar.edges.kind,
@@ -276,11 +301,11 @@ TEST(Alignment, KittiRateDropsWithTwoDegreesOfError) {
     }
     std::printf("\n");
   }
-  std::printf("mean: plain %.1f%% (roll %.1f, pitch %.1f, yaw %.1f); oriented %.1f%% (roll %.1f, "
-              "pitch %.1f, yaw %.1f)\n",
-              100 * plain_true, 100 * plain_off[0], 100 * plain_off[1], 100 * plain_off[2],
-              100 * oriented_true, 100 * oriented_off[0], 100 * oriented_off[1],
-              100 * oriented_off[2]);
+  std::printf(
+      "mean: plain %.1f%% (roll %.1f, pitch %.1f, yaw %.1f); oriented %.1f%% (roll %.1f, "
+      "pitch %.1f, yaw %.1f)\n",
+      100 * plain_true, 100 * plain_off[0], 100 * plain_off[1], 100 * plain_off[2],
+      100 * oriented_true, 100 * oriented_off[0], 100 * oriented_off[1], 100 * oriented_off[2]);
   EXPECT_GT(oriented_true, 0.55);
   for (int axis = 0; axis < 3; ++axis) {
     EXPECT_LT(plain_off[axis], plain_true) << kAxis[axis];

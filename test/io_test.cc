@@ -1,9 +1,9 @@
 // KITTI raw readers against the shared frames, and exact round trips of every writer.
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-
-#include <gtest/gtest.h>
 
 #include "core/io/drive.h"
 #include "core/io/kitti_calib.h"
@@ -39,10 +39,10 @@ TEST(Timestamps, ParsesToTheNanosecond) {
 
 TEST(Timestamps, RejectsMalformedText) {
   StampNs stamp = 0;
-  for (const char* bad : {"", "2011-09-26", "2011-09-26 13:10:51.", "2011-13-01 00:00:00.0",
-                          "2011-02-29 00:00:00.0", "2011-09-26 24:00:00.0",
-                          "2011-09-26 13:10:51.1234567890", "2011/09/26 13:10:51.1",
-                          "2011-09-26 13:10:51.1x"}) {
+  for (const char* bad :
+       {"", "2011-09-26", "2011-09-26 13:10:51.", "2011-13-01 00:00:00.0", "2011-02-29 00:00:00.0",
+        "2011-09-26 24:00:00.0", "2011-09-26 13:10:51.1234567890", "2011/09/26 13:10:51.1",
+        "2011-09-26 13:10:51.1x"}) {
     EXPECT_FALSE(ParseKittiTimestamp(bad, &stamp)) << "'" << bad << "'";
   }
 }
@@ -99,9 +99,9 @@ TEST(KittiReaders, DriveIndexesThirtyFramesWithMonotonicStamps) {
   EXPECT_EQ(drive.frame_names.back(), "0000000029");
   ASSERT_TRUE(drive.has_oxts);
   ASSERT_TRUE(drive.has_imu_calibration);
-  for (const auto* stamps : {&drive.camera_stamps_ns, &drive.lidar_stamps_ns,
-                             &drive.lidar_start_stamps_ns, &drive.lidar_end_stamps_ns,
-                             &drive.oxts_stamps_ns}) {
+  for (const auto* stamps :
+       {&drive.camera_stamps_ns, &drive.lidar_stamps_ns, &drive.lidar_start_stamps_ns,
+        &drive.lidar_end_stamps_ns, &drive.oxts_stamps_ns}) {
     ASSERT_EQ(stamps->size(), 30u);
     for (size_t i = 1; i < stamps->size(); ++i) EXPECT_GT((*stamps)[i], (*stamps)[i - 1]);
   }
@@ -161,9 +161,9 @@ TEST(KittiReaders, VelodynePointCountsMatchFileSizes) {
 
 TEST(KittiWriters, VeloToCamRoundTripIsExactToPrintedPrecision) {
   testing::ScopedTempDir tmp;
-  const Rigid3d T = MakeRigid(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())
-                                  .toRotationMatrix(),
-                              Eigen::Vector3d(-0.00406976612345, -0.0763161812345, -0.27178));
+  const Rigid3d T =
+      MakeRigid(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix(),
+                Eigen::Vector3d(-0.00406976612345, -0.0763161812345, -0.27178));
   const std::string a = tmp.path() + "/a.txt", b = tmp.path() + "/b.txt";
   ASSERT_TRUE(WriteVeloToCam(a, T).ok());
   Rigid3d read;
@@ -199,7 +199,8 @@ TEST(KittiWriters, OxtsAndVelodyneRoundTripsAreExact) {
   EXPECT_EQ(again.wu, packet.wu);
 
   LidarScan scan;
-  ASSERT_TRUE(ReadVelodyneBin(KittiDriveDir() + "/velodyne_points/data/0000000003.bin", &scan).ok());
+  ASSERT_TRUE(
+      ReadVelodyneBin(KittiDriveDir() + "/velodyne_points/data/0000000003.bin", &scan).ok());
   ASSERT_TRUE(WriteVelodyneBin(tmp.path() + "/v.bin", scan).ok());
   EXPECT_EQ(Slurp(tmp.path() + "/v.bin"),
             Slurp(KittiDriveDir() + "/velodyne_points/data/0000000003.bin"));

@@ -1,9 +1,10 @@
-#include <cmath>
+#include "core/score/projection.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/io/drive.h"
-#include "core/score/projection.h"
 #include "core/types/calibration.h"
 #include "test/test_util.h"
 
@@ -77,8 +78,8 @@ TEST(Projection, KittiFrameZeroLandsInsideTheImage) {
       in_front.size();
   EXPECT_GT(inside, 0.95);
 
-  const Rigid3d wrong = PerturbTcameraLidar(drive.T_camera_lidar, Eigen::Vector3d(0, 0, 90),
-                                            Eigen::Vector3d::Zero());
+  const Rigid3d wrong =
+      PerturbTcameraLidar(drive.T_camera_lidar, Eigen::Vector3d(0, 0, 90), Eigen::Vector3d::Zero());
   const double inside_wrong =
       static_cast<double>(ProjectPoints(camera, wrong, in_front).size()) / in_front.size();
   EXPECT_LT(inside_wrong, 0.05);

@@ -1,16 +1,16 @@
 // The simulator against its own ground truth: geometry (LiDAR edges on image edges), motion
 // (oxts integrates to the true poses), I/O (KITTI reader round trip), determinism and labels.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "core/io/drive.h"
 #include "core/io/image.h"
@@ -43,9 +43,8 @@ std::vector<int> StaticEdgePoints(const SimulatedSweep& sweep, double azimuth_st
   const auto& p = sweep.scan.points_lidar;
   for (size_t i = 0; i + 1 < p.size(); ++i) {
     if (sweep.ring[i] != sweep.ring[i + 1]) continue;
-    const double da = std::remainder(std::atan2(p[i + 1].y(), p[i + 1].x()) -
-                                         std::atan2(p[i].y(), p[i].x()),
-                                     2 * M_PI);
+    const double da = std::remainder(
+        std::atan2(p[i + 1].y(), p[i + 1].x()) - std::atan2(p[i].y(), p[i].x()), 2 * M_PI);
     if (std::abs(da) > 1.5 * azimuth_step_rad) continue;
     const double ri = p[i].norm(), rj = p[i + 1].norm();
     if (std::abs(ri - rj) < std::max(0.5, 0.05 * std::min(ri, rj))) continue;
@@ -56,7 +55,7 @@ std::vector<int> StaticEdgePoints(const SimulatedSweep& sweep, double azimuth_st
 }
 
 struct EdgeDistance {
-  double median_px = 1e9;  ///< median distance to the nearest Canny edge [px]
+  double median_px = 1e9;   ///< median distance to the nearest Canny edge [px]
   double within_1_5px = 0;  ///< share of points within 1.5 px of an edge
   size_t count = 0;
 };
@@ -110,11 +109,13 @@ TEST(Simulator, LidarEdgesLieOnImageEdgesWithTruth) {
       const Rigid3d wrong = PerturbTcameraLidar(sim.T_camera_lidar(), Eigen::Vector3d(0, 0.7, 0.7),
                                                 Eigen::Vector3d::Zero());
       const EdgeDistance off = MeasureEdgeDistance(sim, f, wrong);
-      EXPECT_LT(off.within_1_5px, truth.within_1_5px - 0.15) << "seed " << seed << " frame " << frame;
-      std::printf("seed %llu frame %d: median %.2f px, %.0f%% within 1.5 px (truth); "
-                  "median %.2f px, %.0f%% (1 deg off)\n",
-                  static_cast<unsigned long long>(seed), frame, truth.median_px,
-                  100 * truth.within_1_5px, off.median_px, 100 * off.within_1_5px);
+      EXPECT_LT(off.within_1_5px, truth.within_1_5px - 0.15)
+          << "seed " << seed << " frame " << frame;
+      std::printf(
+          "seed %llu frame %d: median %.2f px, %.0f%% within 1.5 px (truth); "
+          "median %.2f px, %.0f%% (1 deg off)\n",
+          static_cast<unsigned long long>(seed), frame, truth.median_px, 100 * truth.within_1_5px,
+          off.median_px, 100 * off.within_1_5px);
     }
   }
 }
@@ -205,8 +206,7 @@ TEST(Simulator, DriveRoundTripsThroughTheKittiReader) {
     EXPECT_EQ(cv::norm(image, f.image_bgr, cv::NORM_INF), 0.0);
     EXPECT_EQ(FormatOxtsPacket(drive.oxts[i]), FormatOxtsPacket(f.oxts));
   }
-  const nlohmann::json truth =
-      nlohmann::json::parse(Slurp(drive.calib_dir + "/ground_truth.json"));
+  const nlohmann::json truth = nlohmann::json::parse(Slurp(drive.calib_dir + "/ground_truth.json"));
   EXPECT_DOUBLE_EQ(truth["time_offset_s"].get<double>(), 0.03);
   ASSERT_EQ(truth["T_camera_lidar"].size(), 16u);
   for (int k = 0; k < 16; ++k) {
@@ -239,7 +239,8 @@ TEST(Simulator, SameSeedWritesIdenticalFiles) {
   ASSERT_TRUE(WriteSimulatedDrive(SmallOptions(5, 2), a.path(), &drive).ok());
   ASSERT_TRUE(WriteSimulatedDrive(SmallOptions(5, 2), b.path(), &drive).ok());
   ASSERT_TRUE(WriteSimulatedDrive(SmallOptions(6, 2), c.path(), &drive).ok());
-  const auto files_a = ReadTree(a.path()), files_b = ReadTree(b.path()), files_c = ReadTree(c.path());
+  const auto files_a = ReadTree(a.path()), files_b = ReadTree(b.path()),
+             files_c = ReadTree(c.path());
   EXPECT_GT(files_a.size(), 15u);
   EXPECT_TRUE(files_a == files_b);
   EXPECT_FALSE(files_a == files_c);
@@ -296,8 +297,7 @@ TEST(Simulator, DynamicLabelsMarkExactlyThePointsOnMovingObjects) {
 TEST(Simulator, RejectsBadOptionsAndLeavesNothingBehind) {
   SimulatorOptions options;
   for (auto mutate : std::vector<void (*)(SimulatorOptions*)>{
-           [](SimulatorOptions* o) { o->frames = 0; },
-           [](SimulatorOptions* o) { o->frames = -3; },
+           [](SimulatorOptions* o) { o->frames = 0; }, [](SimulatorOptions* o) { o->frames = -3; },
            [](SimulatorOptions* o) { o->lidar_hz = 0; },
            [](SimulatorOptions* o) { o->lidar_hz = 1000; },
            [](SimulatorOptions* o) { o->time_offset_s = 2.0; },

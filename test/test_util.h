@@ -1,12 +1,12 @@
 #pragma once
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "core/io/drive.h"
 
@@ -21,7 +21,7 @@ inline bool HaveKitti() { return std::filesystem::is_directory(KittiDriveDir());
 #define STCALIB_REQUIRE_KITTI()                                                              \
   if (!::stcalib::testing::HaveKitti()) {                                                    \
     GTEST_SKIP() << "shared KITTI data not found at " << ::stcalib::testing::KittiDriveDir() \
-                 << " (clone with ../shared beside the repository)";                        \
+                 << " (clone with ../shared beside the repository)";                         \
   }
 
 // A fresh folder under the system temp dir, removed on destruction.

@@ -1,13 +1,13 @@
 #include "core/features/dynamic_filter.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <numeric>
 #include <unordered_map>
-
-#include <glog/logging.h>
 
 #include "core/features/kdtree.h"
 
@@ -24,14 +24,28 @@ Status DynamicFilterOptions::Validate() const {
 
 namespace {
 
-bool InRegion(const Eigen::Vector3d& p, const DynamicFilterOptions& o, double extra_m) {
-  const double r2 = p.squaredNorm();
-  const double max_r = o.max_range_m + extra_m;
-  if (r2 > max_r * max_r) return false;
-  if (o.roi_half_angle_deg <= 0) return true;
-  const double margin = extra_m > 0 ? 10.0 : 0.0;
-  return std::abs(std::atan2(p.y(), p.x())) * 180.0 / M_PI <= o.roi_half_angle_deg + margin;
-}
+// Range limit and, when set, the azimuth window |atan2(y, x)| ≤ half angle, tested without
+// trigonometry: the angle to the x axis is ≤ half ⇔ x ≥ |(x, y)|·cos(half).
+class Region {
+ public:
+  Region(const DynamicFilterOptions& o, double extra_m, double extra_deg)
+      : max_r2_((o.max_range_m + extra_m) * (o.max_range_m + extra_m)),
+        all_azimuths_(o.roi_half_angle_deg <= 0 || o.roi_half_angle_deg + extra_deg >= 180),
+        cos_half_(std::cos((o.roi_half_angle_deg + extra_deg) * M_PI / 180.0)) {}
+  bool Contains(const Eigen::Vector3d& p) const {
+    if (p.squaredNorm() > max_r2_) return false;
+    if (all_azimuths_) return true;
+    if (cos_half_ >= 0) {
+      return p.x() >= 0 && p.x() * p.x() >= (p.x() * p.x() + p.y() * p.y()) * cos_half_ * cos_half_;
+    }
+    return p.x() >= 0 || p.x() * p.x() <= (p.x() * p.x() + p.y() * p.y()) * cos_half_ * cos_half_;
+  }
+
+ private:
+  double max_r2_;
+  bool all_azimuths_;
+  double cos_half_;
+};
 
 int Find(std::vector<int>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
@@ -41,8 +55,10 @@ int Find(std::vector<int>& parent, int i) {
 // Spherical range image of a sweep: the nearest return per (azimuth, elevation) cell.
 class RangeImage {
  public:
-  explicit RangeImage(const std::vector<Eigen::Vector3d>& points) : range_(kAz * kEl, kEmpty) {
+  RangeImage(const std::vector<Eigen::Vector3d>& points, const Region& region)
+      : range_(kAz * kEl, kEmpty) {
     for (const auto& p : points) {
+      if (!region.Contains(p)) continue;
       const int c = Cell(p);
       if (c >= 0) range_[c] = std::min(range_[c], static_cast<float>(p.norm()));
     }
@@ -76,30 +92,57 @@ class RangeImage {
   std::vector<float> range_;
 };
 
-// Flags the selected current points that `reference` cannot explain.
+int64_t VoxelKey(const Eigen::Vector3d& p, double cell) {
+  const int64_t x = static_cast<int64_t>(std::floor(p.x() / cell));
+  const int64_t y = static_cast<int64_t>(std::floor(p.y() / cell));
+  const int64_t z = static_cast<int64_t>(std::floor(p.z() / cell));
+  return (x & 0x1FFFFF) | ((y & 0x1FFFFF) << 21) | ((z & 0x1FFFFF) << 42);
+}
+
+// Flags the selected current points that `reference` cannot explain. `representative[k]` is the
+// selected point whose query stands for point k (same query voxel).
 void FlagAgainst(const std::vector<Eigen::Vector3d>& current, const std::vector<int>& selected,
-                 const ReferenceSweep& reference, const DynamicFilterOptions& options,
-                 std::vector<uint8_t>* flagged) {
+                 const std::vector<int>& representative, const ReferenceSweep& reference,
+                 const DynamicFilterOptions& options, std::vector<uint8_t>* flagged) {
   const std::vector<Eigen::Vector3d>& own = *reference.points;
   std::vector<Eigen::Vector3d> moved;
-  moved.reserve(own.size());
+  moved.reserve(own.size() / 2);
+  std::unordered_map<int64_t, char> occupied;
+  const Region region(options, 5.0, 10.0);
   for (size_t i = 0; i < own.size(); ++i) {
-    if (reference.ground != nullptr && !reference.ground->empty() && (*reference.ground)[i]) continue;
+    if (reference.ground != nullptr && !reference.ground->empty() && (*reference.ground)[i])
+      continue;
     const Eigen::Vector3d p = reference.T_current_reference * own[i];
-    if (InRegion(p, options, 5.0)) moved.push_back(p);
+    if (!region.Contains(p)) continue;
+    if (options.reference_voxel_m > 0 &&
+        !occupied.emplace(VoxelKey(p, options.reference_voxel_m), 1).second) {
+      continue;
+    }
+    moved.push_back(p);
   }
   if (moved.empty()) return;
   const PointKdTree tree(moved);
   std::unique_ptr<RangeImage> view;
-  if (reference.check_visibility) view = std::make_unique<RangeImage>(own);
+  if (reference.check_visibility) view = std::make_unique<RangeImage>(own, region);
   const Rigid3d T_reference_current = reference.T_current_reference.inverse();
+  std::vector<int8_t> verdict(selected.size(), -1);  // per representative: 0 static, 1 flagged
   for (size_t k = 0; k < selected.size(); ++k) {
     if ((*flagged)[k]) continue;
+    const int rep = representative[k];
+    if (verdict[rep] < 0) {
+      verdict[rep] = 0;
+      const Eigen::Vector3d& p = current[selected[rep]];
+      int nearest;
+      double distance;
+      tree.Nearest(p, &nearest, &distance);
+      // τ(r), widened by the reference voxel's half diagonal.
+      if (distance >
+          options.tau0_m + options.tau_per_range * p.norm() + 0.87 * options.reference_voxel_m) {
+        verdict[rep] = 1;
+      }
+    }
+    if (verdict[rep] == 0) continue;
     const Eigen::Vector3d& p = current[selected[k]];
-    int nearest;
-    double distance;
-    tree.Nearest(p, &nearest, &distance);
-    if (distance <= options.tau0_m + options.tau_per_range * p.norm()) continue;  // τ(r)
     if (view != nullptr) {
       // Seen from the reference viewpoint, was this place free space (a longer return)?
       const Eigen::Vector3d q = T_reference_current * p;
@@ -125,16 +168,28 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
     return result;
   }
   std::vector<int> selected;
+  const Region region(options, 0.0, 0.0);
   for (size_t i = 0; i < current.size(); ++i) {
-    if ((current_ground.empty() || !current_ground[i]) && InRegion(current[i], options, 0.0)) {
+    if ((current_ground.empty() || !current_ground[i]) && region.Contains(current[i])) {
       selected.push_back(static_cast<int>(i));
     }
   }
   if (selected.empty()) return result;
+  // Points sharing a query voxel share one nearest-neighbour query.
+  std::vector<int> representative(selected.size());
+  {
+    std::unordered_map<int64_t, int> first;
+    first.reserve(selected.size());
+    for (size_t k = 0; k < selected.size(); ++k) {
+      const double cell = options.query_voxel_m > 0 ? options.query_voxel_m : 1e-6;
+      representative[k] =
+          first.emplace(VoxelKey(current[selected[k]], cell), static_cast<int>(k)).first->second;
+    }
+  }
   std::vector<uint8_t> flagged(selected.size(), 0);
   for (const ReferenceSweep& reference : references) {
     CHECK(reference.points != nullptr);
-    FlagAgainst(current, selected, reference, options, &flagged);
+    FlagAgainst(current, selected, representative, reference, options, &flagged);
   }
   for (uint8_t f : flagged) result.flagged_points += f;
 
@@ -152,7 +207,8 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
     const Eigen::Vector3i v(static_cast<int>(std::floor(p.x() / cell)),
                             static_cast<int>(std::floor(p.y() / cell)),
                             static_cast<int>(std::floor(p.z() / cell)));
-    auto [it, inserted] = voxel_id.emplace(key(v.x(), v.y(), v.z()), static_cast<int>(voxels.size()));
+    auto [it, inserted] =
+        voxel_id.emplace(key(v.x(), v.y(), v.z()), static_cast<int>(voxels.size()));
     if (inserted) voxels.push_back(v);
     point_voxel[k] = it->second;
   }

@@ -1,9 +1,8 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/types/status.h"
 #include "core/types/transform.h"
@@ -18,18 +17,22 @@ namespace stcalib {
 // The current non-ground points are clustered (Euclidean, on a voxel grid) and whole clusters
 // with enough flagged points are removed.
 struct DynamicFilterOptions {
-  double tau0_m = 0.15;                 ///< τ0 [m]
-  double tau_per_range = 0.008;         ///< k [m/m]: beam spacing grows with range
-  double max_range_m = 80.0;            ///< points beyond are left alone [m]
-  double roi_half_angle_deg = 0.0;      ///< only |azimuth| ≤ this (camera view); 0 = all
-  double cluster_tolerance_m = 0.45;    ///< voxel size of the clustering [m]
-  int min_flagged_points = 6;           ///< a dynamic cluster has at least this many flagged
-  double min_flagged_fraction = 0.12;   ///< ... and at least this share of its points flagged
-  double max_cluster_extent_m = 14.0;   ///< larger clusters are structure, never removed [m]
-  double visibility_margin_m = 0.3;     ///< previous range must exceed ours by this (+2 %) [m]
+  double tau0_m = 0.15;                ///< τ0 [m]
+  double tau_per_range = 0.008;        ///< k [m/m]: beam spacing grows with range
+  double max_range_m = 80.0;           ///< points beyond are left alone [m]
+  double roi_half_angle_deg = 0.0;     ///< only |azimuth| ≤ this (camera view); 0 = all
+  double cluster_tolerance_m = 0.45;   ///< voxel size of the clustering [m]
+  int min_flagged_points = 6;          ///< a dynamic cluster has at least this many flagged
+  double min_flagged_fraction = 0.12;  ///< ... and at least this share of its points flagged
+  double max_cluster_extent_m = 14.0;  ///< larger clusters are structure, never removed [m]
+  double visibility_margin_m = 0.3;    ///< previous range must exceed ours by this (+2 %) [m]
   // Slow movers (pedestrians) shift less than τ between adjacent sweeps; a second, older
   // reference sweep this far back, compared with the visibility check, catches them [s].
   double long_baseline_s = 0.3;
+  // Speed: reference sweeps keep one point per voxel of this size, and current points sharing a
+  // voxel share one nearest-neighbour query [m].
+  double reference_voxel_m = 0.0;
+  double query_voxel_m = 0.0;
 
   Status Validate() const;
 };

@@ -1,10 +1,10 @@
 #include "core/features/ground.h"
 
-#include <cmath>
-#include <random>
+#include <glog/logging.h>
 
 #include <Eigen/Eigenvalues>
-#include <glog/logging.h>
+#include <cmath>
+#include <random>
 
 namespace stcalib {
 
@@ -16,14 +16,16 @@ Status GroundOptions::Validate() const {
   return Status::Ok();
 }
 
-GroundPlane FitGroundPlane(const std::vector<Eigen::Vector3d>& points, const GroundOptions& options) {
+GroundPlane FitGroundPlane(const std::vector<Eigen::Vector3d>& points,
+                           const GroundOptions& options) {
   CHECK(options.Validate().ok()) << options.Validate().message();
   GroundPlane best;
   std::vector<int> candidates;
   for (int i = 0; i < static_cast<int>(points.size()); ++i) {
     const Eigen::Vector3d& p = points[i];
     // Low returns only: below the sensor, within the fit range.
-    if (p.z() < -0.3 && p.head<2>().squaredNorm() < options.max_fit_range_m * options.max_fit_range_m) {
+    if (p.z() < -0.3 &&
+        p.head<2>().squaredNorm() < options.max_fit_range_m * options.max_fit_range_m) {
       candidates.push_back(i);
     }
   }
@@ -50,7 +52,8 @@ GroundPlane FitGroundPlane(const std::vector<Eigen::Vector3d>& points, const Gro
     if (n.z() < cos_tilt) continue;
     const double d = -n.dot(a);
     int inliers = 0;
-    for (const Eigen::Vector3d& p : sample) inliers += std::abs(n.dot(p) + d) < options.inlier_threshold_m;
+    for (const Eigen::Vector3d& p : sample)
+      inliers += std::abs(n.dot(p) + d) < options.inlier_threshold_m;
     if (inliers > best.inliers) {
       best.normal = n;
       best.offset = d;

@@ -1,9 +1,8 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/types/status.h"
 
@@ -12,12 +11,12 @@ namespace stcalib {
 // Ground removal (method.md §4): a RANSAC plane through the nearby, low returns, refined by least
 // squares on its inliers; points within `band_m` of it (or below it) are ground.
 struct GroundOptions {
-  double max_fit_range_m = 30.0;   ///< only returns this close (horizontally) fit the plane [m]
-  double max_tilt_deg = 15.0;      ///< plane normals further than this from LiDAR z are rejected
+  double max_fit_range_m = 30.0;     ///< only returns this close (horizontally) fit the plane [m]
+  double max_tilt_deg = 15.0;        ///< plane normals further than this from LiDAR z are rejected
   double inlier_threshold_m = 0.12;  ///< RANSAC inlier distance [m]
-  double band_m = 0.25;            ///< points up to this high above the plane are ground [m]
+  double band_m = 0.25;              ///< points up to this high above the plane are ground [m]
   int iterations = 80;
-  int sample_points = 3000;        ///< returns drawn for the RANSAC consensus
+  int sample_points = 3000;  ///< returns drawn for the RANSAC consensus
   uint64_t seed = 7;
 
   Status Validate() const;
@@ -25,9 +24,9 @@ struct GroundOptions {
 
 struct GroundPlane {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit, pointing up (z > 0)
-  double offset = 0;  ///< plane: normal · p + offset = 0
+  double offset = 0;                                  ///< plane: normal · p + offset = 0
   bool valid = false;
-  int inliers = 0;    ///< inliers among the sampled returns
+  int inliers = 0;  ///< inliers among the sampled returns
 
   double Height(const Eigen::Vector3d& p) const { return normal.dot(p) + offset; }
 };

@@ -1,9 +1,9 @@
 #include "core/features/image_features.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <glog/logging.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/ximgproc/fast_line_detector.hpp>
 
@@ -11,7 +11,8 @@ namespace stcalib {
 namespace {
 
 void Smooth(cv::Mat* map, double sigma_px) {
-  if (sigma_px > 0) cv::GaussianBlur(*map, *map, cv::Size(), sigma_px, sigma_px, cv::BORDER_REPLICATE);
+  if (sigma_px > 0)
+    cv::GaussianBlur(*map, *map, cv::Size(), sigma_px, sigma_px, cv::BORDER_REPLICATE);
 }
 
 // Draws segments at least min_length long (full-size coordinates) into the mask.
@@ -103,26 +104,51 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     gray = image;
   }
   if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
+  const cv::Rect full(0, 0, gray.cols, gray.rows);
+  const cv::Rect roi =
+      options.region_of_interest.area() > 0 ? (options.region_of_interest & full) : full;
+  if (roi != full) {
+    // Work on the crop (everything costs in proportion to its area), then embed: outside the
+    // region there are no edges.
+    ImageFeatureOptions crop_options = options;
+    crop_options.region_of_interest = cv::Rect();
+    const ImageFeatures crop =
+        roi.area() > 0 ? ExtractImageFeatures(gray(roi).clone(), crop_options) : ImageFeatures();
+    auto embed = [&](const cv::Mat& part, int type, double fill) {
+      cv::Mat out(gray.size(), type, cv::Scalar(fill));
+      if (!part.empty()) part.copyTo(out(roi));
+      return out;
+    };
+    const double far = 1e6;
+    features.edge_mask = embed(crop.edge_mask, CV_8U, 0);
+    features.distance_raw_px = embed(crop.distance_raw_px, CV_32F, far);
+    if (options.split_orientation) {
+      features.distance_vertical_raw_px = embed(crop.distance_vertical_raw_px, CV_32F, far);
+      features.distance_horizontal_raw_px = embed(crop.distance_horizontal_raw_px, CV_32F, far);
+    }
+    features.distance_px = embed(crop.distance_px, CV_32F, options.basin_px);
+    features.idt = embed(crop.idt, CV_32F, 0);
+    features.idt_suppressed = embed(crop.idt_suppressed, CV_32F, 0);
+    for (size_t i = 0; i < options.pyramid_basins_px.size(); ++i) {
+      features.idt_pyramid.push_back(
+          embed(i < crop.idt_pyramid.size() ? crop.idt_pyramid[i] : cv::Mat(), CV_32F, 0));
+    }
+    features.segments = crop.segments;
+    for (cv::Vec4f& s : features.segments) s += cv::Vec4f(roi.x, roi.y, roi.x, roi.y);
+    features.edge_pixels = crop.edge_pixels;
+    features.dense_pixels_removed = crop.dense_pixels_removed;
+    return features;
+  }
   cv::Mat blurred = gray;
   if (options.pre_blur_sigma_px > 0) {
     cv::GaussianBlur(gray, blurred, cv::Size(), options.pre_blur_sigma_px);
   }
-
   features.edge_mask = cv::Mat::zeros(gray.size(), CV_8U);
-  const cv::Rect full(0, 0, gray.cols, gray.rows);
-  const cv::Rect roi =
-      options.region_of_interest.area() > 0 ? (options.region_of_interest & full) : full;
-  if (roi.area() > 0) {
-    cv::Mat mask_roi = features.edge_mask(roi);
-    if (options.detector == ImageFeatureOptions::Detector::kCanny) {
-      cv::Canny(blurred(roi), mask_roi, options.canny_low, options.canny_high);
-    } else {
-      features.segments = DetectSegments(blurred(roi), options);
-      for (cv::Vec4f& s : features.segments) {
-        s += cv::Vec4f(roi.x, roi.y, roi.x, roi.y);
-      }
-      DrawSegments(features.segments, options.min_segment_length_px, &features.edge_mask);
-    }
+  if (options.detector == ImageFeatureOptions::Detector::kCanny) {
+    cv::Canny(blurred, features.edge_mask, options.canny_low, options.canny_high);
+  } else {
+    features.segments = DetectSegments(blurred, options);
+    DrawSegments(features.segments, options.min_segment_length_px, &features.edge_mask);
   }
   if (options.max_edge_density > 0) {
     cv::Mat density;
@@ -140,6 +166,10 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     LOG(WARNING) << "image features: no edges found (black, flat or featureless image)";
     features.distance_px = cv::Mat(gray.size(), CV_32F, cv::Scalar(options.basin_px));
     features.distance_raw_px = cv::Mat(gray.size(), CV_32F, cv::Scalar(1e6));
+    if (options.split_orientation) {
+      features.distance_vertical_raw_px = features.distance_raw_px.clone();
+      features.distance_horizontal_raw_px = features.distance_raw_px.clone();
+    }
     features.idt = cv::Mat::zeros(gray.size(), CV_32F);
     features.idt_suppressed = features.idt.clone();
     for (size_t i = 0; i < options.pyramid_basins_px.size(); ++i) {
@@ -148,19 +178,20 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     return features;
   }
 
-  cv::distanceTransform(255 - features.edge_mask, features.distance_raw_px, cv::DIST_L2,
-                        cv::DIST_MASK_5);
+  const int mask = options.precise_distance ? cv::DIST_MASK_PRECISE : cv::DIST_MASK_3;
+  cv::distanceTransform(255 - features.edge_mask, features.distance_raw_px, cv::DIST_L2, mask);
   if (options.split_orientation) {
     // Gradient mostly along x = a near-vertical line; the 30° band in between goes to both.
     cv::Mat gx, gy;
     cv::Sobel(blurred, gx, CV_32F, 1, 0, 3);
     cv::Sobel(blurred, gy, CV_32F, 0, 1, 3);
     const cv::Mat abs_gx = cv::abs(gx), abs_gy = cv::abs(gy);
-    const cv::Mat vertical = (abs_gx * 0.577f >= abs_gy) & features.edge_mask;    // within 30° of vertical
-    const cv::Mat horizontal = (abs_gy * 0.577f >= abs_gx) & features.edge_mask;  // within 30° of horizontal
-    cv::distanceTransform(255 - vertical, features.distance_vertical_raw_px, cv::DIST_L2, cv::DIST_MASK_5);
-    cv::distanceTransform(255 - horizontal, features.distance_horizontal_raw_px, cv::DIST_L2,
-                          cv::DIST_MASK_5);
+    const cv::Mat vertical =
+        (abs_gx * 0.577f >= abs_gy) & features.edge_mask;  // within 30° of vertical
+    const cv::Mat horizontal =
+        (abs_gy * 0.577f >= abs_gx) & features.edge_mask;  // within 30° of horizontal
+    cv::distanceTransform(255 - vertical, features.distance_vertical_raw_px, cv::DIST_L2, mask);
+    cv::distanceTransform(255 - horizontal, features.distance_horizontal_raw_px, cv::DIST_L2, mask);
   }
   const cv::Mat& distance = features.distance_raw_px;
   features.idt = InverseDistanceTransform(distance, options.basin_px, options.smoothing_sigma_px);

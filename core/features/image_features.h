@@ -1,9 +1,8 @@
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/types/status.h"
 
@@ -20,14 +19,14 @@ struct ImageFeatureOptions {
     kFastLine,  ///< cv::ximgproc FastLineDetector segments drawn into the mask
   };
   Detector detector = Detector::kCanny;
-  double pre_blur_sigma_px = 1.0;   ///< Gaussian σ before edge detection [px], 0 = none
-  double canny_low = 40;            ///< Canny hysteresis thresholds [grey levels]
+  double pre_blur_sigma_px = 1.0;  ///< Gaussian σ before edge detection [px], 0 = none
+  double canny_low = 40;           ///< Canny hysteresis thresholds [grey levels]
   double canny_high = 120;
-  double line_scale = 0.5;          ///< image scale LSD / FastLineDetector run at (0, 1]
+  double line_scale = 0.5;            ///< image scale LSD / FastLineDetector run at (0, 1]
   double min_segment_length_px = 15;  ///< shorter segments are texture, not drawn [px, full size]
-  double basin_px = 20;             ///< D_max of the IDT [px]
-  double smoothing_sigma_px = 1.5;  ///< Gaussian σ applied to the IDT and distance maps [px]
-  double suppression_sigma_px = 12;  ///< wide blur subtracted for the texture-suppressed map [px]
+  double basin_px = 20;               ///< D_max of the IDT [px]
+  double smoothing_sigma_px = 1.5;    ///< Gaussian σ applied to the IDT and distance maps [px]
+  double suppression_sigma_px = 12;   ///< wide blur subtracted for the texture-suppressed map [px]
   std::vector<double> pyramid_basins_px;  ///< extra texture-suppressed IDTs, e.g. {60, 30}
   // Texture suppression on the edge mask: edge pixels whose (2·density_window_px+1)² window is
   // denser than this share of edge pixels are dropped (foliage, gravel); 0 = keep all.
@@ -36,7 +35,8 @@ struct ImageFeatureOptions {
   // Also split the edges by orientation (Sobel gradient) into near-vertical and near-horizontal
   // lines with one distance map each, so that vertical LiDAR edges are compared with vertical
   // image edges only (dense texture has every orientation; structure has one).
-  bool split_orientation = true;
+  bool split_orientation = false;
+  bool precise_distance = false;  ///< exact Euclidean DT (5.6 ms) instead of the 3×3 mask (3.3 ms)
   // Rectangle of interest (x, y, w, h) [px]; empty = whole image. Outside it the maps are flat.
   cv::Rect region_of_interest;
 
@@ -45,15 +45,15 @@ struct ImageFeatureOptions {
 
 struct ImageFeatures {
   cv::Mat edge_mask;        ///< CV_8U, 255 on edge pixels
-  cv::Mat distance_raw_px;  ///< CV_32F, exact distance to the nearest edge pixel [px]
+  cv::Mat distance_raw_px;  ///< CV_32F, distance to the nearest edge pixel [px], unsmoothed
   cv::Mat distance_px;      ///< CV_32F, smoothed min(D, basin) [px]; 0 on edges
-  cv::Mat distance_vertical_raw_px;    ///< exact distance to near-vertical edge pixels [px]
-  cv::Mat distance_horizontal_raw_px;  ///< exact distance to near-horizontal edge pixels [px]
-  cv::Mat idt;              ///< CV_32F, smoothed IDT in [0, 255]
-  cv::Mat idt_suppressed;   ///< CV_32F, max(0, IDT − wide blur of IDT): dense texture fades
+  cv::Mat distance_vertical_raw_px;    ///< to near-vertical edge pixels [px] (split_orientation)
+  cv::Mat distance_horizontal_raw_px;  ///< to near-horizontal edge pixels [px] (split_orientation)
+  cv::Mat idt;                         ///< CV_32F, smoothed IDT in [0, 255]
+  cv::Mat idt_suppressed;  ///< CV_32F, max(0, IDT − wide blur of IDT): dense texture fades
   std::vector<cv::Mat> idt_pyramid;  ///< texture-suppressed IDTs at pyramid_basins_px
   std::vector<cv::Vec4f> segments;   ///< line segments at full-size coordinates (LSD/FLD)
-  int edge_pixels = 0;      ///< after texture suppression
+  int edge_pixels = 0;               ///< after texture suppression
   int dense_pixels_removed = 0;
 
   bool empty() const { return edge_pixels == 0; }

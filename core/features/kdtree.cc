@@ -1,7 +1,6 @@
 #include "core/features/kdtree.h"
 
 #include <cmath>
-
 #include <nanoflann.hpp>
 
 namespace stcalib {
@@ -13,7 +12,9 @@ struct PointKdTree::Impl {
     size_t kdtree_get_point_count() const { return xyz.size() / 3; }
     float kdtree_get_pt(size_t i, size_t dim) const { return xyz[3 * i + dim]; }
     template <class BBox>
-    bool kdtree_get_bbox(BBox&) const { return false; }
+    bool kdtree_get_bbox(BBox&) const {
+      return false;
+    }
   };
   using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Dataset>,
                                                    Dataset, 3, uint32_t>;
@@ -28,8 +29,8 @@ PointKdTree::PointKdTree(const std::vector<Eigen::Vector3d>& points) : impl_(new
     impl_->data.xyz.push_back(static_cast<float>(p.y()));
     impl_->data.xyz.push_back(static_cast<float>(p.z()));
   }
-  impl_->tree = std::make_unique<Impl::Tree>(3, impl_->data,
-                                             nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  impl_->tree =
+      std::make_unique<Impl::Tree>(3, impl_->data, nanoflann::KDTreeSingleIndexAdaptorParams(32));
   if (!points.empty()) impl_->tree->buildIndex();
 }
 

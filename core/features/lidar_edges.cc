@@ -1,10 +1,10 @@
 #include "core/features/lidar_edges.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <glog/logging.h>
 
 namespace stcalib {
 namespace {
@@ -17,33 +17,24 @@ LidarEdges KeepRuns(const LidarEdges &edges, const ScanRings &rings,
                     const LidarEdgeOptions &options) {
   // Edge points by ring, sorted by azimuth.
   std::vector<std::vector<int>> by_ring(rings.num_rings());
-  for (size_t k = 0; k < edges.size(); ++k)
-    by_ring[rings.ring[edges.source_index[k]]].push_back(k);
-  auto azimuth = [&](int k) {
-    return rings.azimuth_rad[edges.source_index[k]];
-  };
+  for (size_t k = 0; k < edges.size(); ++k) by_ring[rings.ring[edges.source_index[k]]].push_back(k);
+  auto azimuth = [&](int k) { return rings.azimuth_rad[edges.source_index[k]]; };
   auto range = [&](int k) { return rings.range_m[edges.source_index[k]]; };
   for (auto &list : by_ring) {
-    std::sort(list.begin(), list.end(),
-              [&](int a, int b) { return azimuth(a) < azimuth(b); });
+    std::sort(list.begin(), list.end(), [&](int a, int b) { return azimuth(a) < azimuth(b); });
   }
   const double window = options.run_azimuth_deg * M_PI / 180.0;
   const double along_window = 3.5 * std::max(rings.azimuth_step_rad, 1e-4);
   auto supporters = [&](int k, int ring, EdgeKind kind, double half_width) {
-    if (ring < 0 || ring >= rings.num_rings())
-      return 0;
+    if (ring < 0 || ring >= rings.num_rings()) return 0;
     const std::vector<int> &list = by_ring[ring];
     const float a = azimuth(k);
-    auto it = std::lower_bound(
-        list.begin(), list.end(), a - half_width,
-        [&](int j, double value) { return azimuth(j) < value; });
+    auto it = std::lower_bound(list.begin(), list.end(), a - half_width,
+                               [&](int j, double value) { return azimuth(j) < value; });
     int count = 0;
     for (; it != list.end() && azimuth(*it) <= a + half_width; ++it) {
-      if (*it == k || edges.kind[*it] != kind)
-        continue;
-      if (std::abs(range(*it) - range(k)) <=
-          options.run_range_tolerance * range(k) + 0.1)
-        ++count;
+      if (*it == k || edges.kind[*it] != kind) continue;
+      if (std::abs(range(*it) - range(k)) <= options.run_range_tolerance * range(k) + 0.1) ++count;
     }
     return count;
   };
@@ -56,15 +47,13 @@ LidarEdges KeepRuns(const LidarEdges &edges, const ScanRings &rings,
       for (int d : {-1, 1}) {
         const int r = rank + d;
         if (r >= 0 && r < rings.num_rings()) {
-          support += supporters(k, rings.order_by_elevation[r],
-                                EdgeKind::kVertical, window);
+          support += supporters(k, rings.order_by_elevation[r], EdgeKind::kVertical, window);
         }
       }
     } else {
       support = supporters(k, ring, EdgeKind::kHorizontal, along_window);
     }
-    if (support < options.run_support)
-      continue;
+    if (support < options.run_support) continue;
     kept.points_lidar.push_back(edges.points_lidar[k]);
     kept.time_s.push_back(edges.time_s[k]);
     kept.kind.push_back(edges.kind[k]);
@@ -73,7 +62,7 @@ LidarEdges KeepRuns(const LidarEdges &edges, const ScanRings &rings,
   return kept;
 }
 
-} // namespace
+}  // namespace
 
 Status LidarEdgeOptions::Validate() const {
   if (!(min_range_m >= 0 && max_range_m > min_range_m)) {
@@ -87,18 +76,15 @@ Status LidarEdgeOptions::Validate() const {
 }
 
 void LidarEdges::Append(const LidarEdges &other) {
-  points_lidar.insert(points_lidar.end(), other.points_lidar.begin(),
-                      other.points_lidar.end());
+  points_lidar.insert(points_lidar.end(), other.points_lidar.begin(), other.points_lidar.end());
   time_s.insert(time_s.end(), other.time_s.begin(), other.time_s.end());
   kind.insert(kind.end(), other.kind.begin(), other.kind.end());
-  source_index.insert(source_index.end(), other.source_index.begin(),
-                      other.source_index.end());
+  source_index.insert(source_index.end(), other.source_index.begin(), other.source_index.end());
 }
 
 LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
                              const std::vector<double> &point_time_s,
-                             const std::vector<PointUse> *use,
-                             const LidarEdgeOptions &options) {
+                             const std::vector<PointUse> *use, const LidarEdgeOptions &options) {
   CHECK(options.Validate().ok()) << options.Validate().message();
   CHECK_EQ(rings.ring.size(), scan.size());
   CHECK_EQ(point_time_s.size(), scan.size());
@@ -108,35 +94,23 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
     LOG(WARNING) << "lidar edges: empty scan, no edges";
     return edges;
   }
-  const double step =
-      rings.azimuth_step_rad > 0 ? rings.azimuth_step_rad : 0.0016;
-  auto usage = [&](int i) {
-    return use == nullptr ? PointUse::kUse : (*use)[i];
-  };
-  auto jump = [&](double near) {
-    return options.jump_min_m + options.jump_per_range * near;
-  };
-  auto smooth = [&](double r) {
-    return options.smooth_tolerance_m + options.smooth_per_range * r;
-  };
-  auto in_range = [&](double r) {
-    return r >= options.min_range_m && r <= options.max_range_m;
-  };
+  const double step = rings.azimuth_step_rad > 0 ? rings.azimuth_step_rad : 0.0016;
+  auto usage = [&](int i) { return use == nullptr ? PointUse::kUse : (*use)[i]; };
+  auto jump = [&](double near) { return options.jump_min_m + options.jump_per_range * near; };
+  auto smooth = [&](double r) { return options.smooth_tolerance_m + options.smooth_per_range * r; };
+  auto in_range = [&](double r) { return r >= options.min_range_m && r <= options.max_range_m; };
   std::vector<uint8_t> is_edge(scan.size(), 0);
   // The silhouette lies between the near return and its far neighbour: the edge
   // point is put at the near range on the bisecting direction (half a beam or
   // azimuth step towards the far side), which removes the half-step bias of
   // taking the near return itself.
   auto add = [&](int i, EdgeKind kind, int far) {
-    if (is_edge[i])
-      return;
+    if (is_edge[i]) return;
     is_edge[i] = 1;
     Eigen::Vector3d p = scan.points_lidar[i];
     if (far >= 0) {
-      const Eigen::Vector3d bisector =
-          p.normalized() + scan.points_lidar[far].normalized();
-      if (bisector.norm() > 1e-6)
-        p = bisector.normalized() * rings.range_m[i];
+      const Eigen::Vector3d bisector = p.normalized() + scan.points_lidar[far].normalized();
+      if (bisector.norm() > 1e-6) p = bisector.normalized() * rings.range_m[i];
     }
     edges.points_lidar.push_back(p);
     edges.time_s.push_back(point_time_s[i]);
@@ -148,8 +122,7 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
   for (int r = 0; r < rings.num_rings(); ++r) {
     const int begin = rings.ring_begin[r], end = rings.ring_begin[r + 1];
     const int count = end - begin;
-    if (count < 2 * options.smooth_neighbours + 2)
-      continue;
+    if (count < 2 * options.smooth_neighbours + 2) continue;
     // Range of the neighbour `k` steps from i in direction dir, or +inf when
     // there is none within the gap limit (no return); dynamic neighbours are
     // reported as NaN.
@@ -157,40 +130,32 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
       int j = i;
       for (int s = 0; s < k; ++s) {
         const int next = j + dir;
-        if (next < begin || next >= end)
-          return kNoReturn;
-        const double gap = std::abs(std::remainder(
-            rings.azimuth_rad[next] - rings.azimuth_rad[j], 2 * M_PI));
-        if (gap > options.max_gap_steps * step)
-          return kNoReturn;
+        if (next < begin || next >= end) return kNoReturn;
+        const double gap =
+            std::abs(std::remainder(rings.azimuth_rad[next] - rings.azimuth_rad[j], 2 * M_PI));
+        if (gap > options.max_gap_steps * step) return kNoReturn;
         j = next;
       }
       *index = j;
-      if (usage(j) == PointUse::kDynamic)
-        return std::numeric_limits<float>::quiet_NaN();
-      if (usage(j) == PointUse::kGround)
-        return kNoReturn;
+      if (usage(j) == PointUse::kDynamic) return std::numeric_limits<float>::quiet_NaN();
+      if (usage(j) == PointUse::kGround) return kNoReturn;
       return rings.range_m[j];
     };
     for (int i = begin; i < end; ++i) {
-      if (usage(i) != PointUse::kUse)
-        continue;
+      if (usage(i) != PointUse::kUse) continue;
       const float r = rings.range_m[i];
-      if (!in_range(r))
-        continue;
+      if (!in_range(r)) continue;
       for (int dir : {-1, 1}) {
         int j = -1;
         const float other = neighbour(i, dir, 1, &j);
-        if (std::isnan(other) || other - r < jump(r))
-          continue; // i must be the near side
+        if (std::isnan(other) || other - r < jump(r)) continue;  // i must be the near side
         // The near side continues smoothly away from the jump.
         bool smooth_side = true;
         float previous = r;
         for (int k = 1; k <= options.smooth_neighbours && smooth_side; ++k) {
           int n = -1;
           const float rn = neighbour(i, -dir, k, &n);
-          smooth_side =
-              std::isfinite(rn) && std::abs(rn - previous) < smooth(r);
+          smooth_side = std::isfinite(rn) && std::abs(rn - previous) < smooth(r);
           previous = rn;
         }
         if (smooth_side) {
@@ -209,8 +174,7 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
       int b = static_cast<int>((azimuth + M_PI) / step);
       return std::min(std::max(b, 0), bins - 1);
     };
-    std::vector<std::vector<int>> table(rings.num_rings(),
-                                        std::vector<int>(bins, -1));
+    std::vector<std::vector<int>> table(rings.num_rings(), std::vector<int>(bins, -1));
     for (int r = 0; r < rings.num_rings(); ++r) {
       for (int i = rings.ring_begin[r]; i < rings.ring_begin[r + 1]; ++i) {
         table[r][bin_of(rings.azimuth_rad[i])] = i;
@@ -220,35 +184,26 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
     // return (sky), NaN when undecidable (ground, dynamic, ring missing).
     auto vertical_neighbour = [&](int i, int k, int *index) -> float {
       const int rank = rings.elevation_rank[rings.ring[i]] + k;
-      if (rank < 0 || rank >= rings.num_rings())
-        return std::numeric_limits<float>::quiet_NaN();
+      if (rank < 0 || rank >= rings.num_rings()) return std::numeric_limits<float>::quiet_NaN();
       const int b = bin_of(rings.azimuth_rad[i]);
       const std::vector<int> &row = table[rings.order_by_elevation[rank]];
       int j = row[b];
-      if (j < 0 && b > 0)
-        j = row[b - 1];
-      if (j < 0 && b + 1 < bins)
-        j = row[b + 1];
-      if (j < 0)
-        return kNoReturn;
+      if (j < 0 && b > 0) j = row[b - 1];
+      if (j < 0 && b + 1 < bins) j = row[b + 1];
+      if (j < 0) return kNoReturn;
       *index = j;
-      if (usage(j) != PointUse::kUse)
-        return std::numeric_limits<float>::quiet_NaN();
+      if (usage(j) != PointUse::kUse) return std::numeric_limits<float>::quiet_NaN();
       return rings.range_m[j];
     };
     for (size_t i = 0; i < scan.size(); ++i) {
-      if (is_edge[i] || usage(i) != PointUse::kUse)
-        continue;
+      if (is_edge[i] || usage(i) != PointUse::kUse) continue;
       const float r = rings.range_m[i];
-      if (!in_range(r))
-        continue;
+      if (!in_range(r)) continue;
       for (int dir : {-1, 1}) {
         int far = -1, unused = -1;
         const float other = vertical_neighbour(static_cast<int>(i), dir, &far);
-        if (std::isnan(other) || other - r < jump(r))
-          continue;
-        const float next =
-            vertical_neighbour(static_cast<int>(i), -dir, &unused);
+        if (std::isnan(other) || other - r < jump(r)) continue;
+        const float next = vertical_neighbour(static_cast<int>(i), -dir, &unused);
         if (std::isfinite(next) && std::abs(next - r) < smooth(r)) {
           add(static_cast<int>(i), EdgeKind::kHorizontal, far);
           break;
@@ -256,9 +211,8 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
       }
     }
   };
-  if (options.horizontal_edges && rings.num_rings() >= 3)
-    AddHorizontal();
+  if (options.horizontal_edges && rings.num_rings() >= 3) AddHorizontal();
   return options.run_support > 0 ? KeepRuns(edges, rings, options) : edges;
 }
 
-} // namespace stcalib
+}  // namespace stcalib

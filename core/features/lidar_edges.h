@@ -1,9 +1,8 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/features/lidar_rings.h"
 #include "core/io/velodyne.h"
@@ -37,7 +36,7 @@ struct LidarEdgeOptions {
   // nearly the same azimuth and range), a horizontal one along its ring. Points without
   // `run_support` such neighbours are dropped: scattered foliage edges do not line up.
   int run_support = 1;
-  double run_azimuth_deg = 0.6;      ///< azimuth window for a vertical-edge neighbour [deg]
+  double run_azimuth_deg = 0.6;       ///< azimuth window for a vertical-edge neighbour [deg]
   double run_range_tolerance = 0.05;  ///< relative range difference allowed within a run
 
   Status Validate() const;
@@ -47,7 +46,7 @@ enum class EdgeKind : uint8_t { kVertical = 0, kHorizontal = 1 };
 
 struct LidarEdges {
   std::vector<Eigen::Vector3d> points_lidar;
-  std::vector<double> time_s;    ///< capture time relative to the sweep stamp [s]
+  std::vector<double> time_s;  ///< capture time relative to the sweep stamp [s]
   std::vector<EdgeKind> kind;
   std::vector<int> source_index;  ///< index in the scan (−1 after merging into a local map)
 

@@ -1,8 +1,8 @@
 #include "core/features/lidar_frame.h"
 
-#include <map>
-
 #include <glog/logging.h>
+
+#include <map>
 
 namespace stcalib {
 
@@ -53,7 +53,8 @@ void FinishLidarFrameFeatures(const std::vector<ReferenceFeatures>& references,
   for (size_t k = 0; k < f->edges.size(); ++k) {
     // Keep the bisector placement of the edge point, moved to the stamp like its source.
     const int i = f->edges.source_index[k];
-    f->edges.points_lidar[k] = f->deskewed[i] + (f->edges.points_lidar[k] - f->scan.points_lidar[i]);
+    f->edges.points_lidar[k] =
+        f->deskewed[i] + (f->edges.points_lidar[k] - f->scan.points_lidar[i]);
   }
 }
 
@@ -83,8 +84,9 @@ class BaseCache {
       STCALIB_RETURN_IF_ERROR(drive_.LoadScan(frame, &scan));
       if (scan.size() == 0) LOG(WARNING) << drive_.VelodynePath(frame) << ": empty sweep";
       const double stamp = motion_.Seconds(drive_.lidar_stamps_ns[frame]);
-      it = cache_.emplace(frame, ComputeLidarSweepBase(std::move(scan), stamp, sweep_s_,
-                                                       motion_.PoseFunction(), options_))
+      it = cache_
+               .emplace(frame, ComputeLidarSweepBase(std::move(scan), stamp, sweep_s_,
+                                                     motion_.PoseFunction(), options_))
                .first;
     }
     *features = &it->second;
@@ -95,12 +97,14 @@ class BaseCache {
   Status References(size_t frame, std::vector<ReferenceFeatures>* references) {
     references->clear();
     if (!options_.remove_dynamic || frame == 0) return Status::Ok();
-    const double period = drive_.NumFrames() > 1
-                              ? NsToSeconds(drive_.lidar_stamps_ns.back() - drive_.lidar_stamps_ns.front()) /
-                                    (drive_.NumFrames() - 1)
-                              : 0.1;
-    const size_t back = std::max<size_t>(
-        1, static_cast<size_t>(std::lround(options_.dynamic.long_baseline_s / std::max(period, 1e-3))));
+    const double period =
+        drive_.NumFrames() > 1
+            ? NsToSeconds(drive_.lidar_stamps_ns.back() - drive_.lidar_stamps_ns.front()) /
+                  (drive_.NumFrames() - 1)
+            : 0.1;
+    const size_t back =
+        std::max<size_t>(1, static_cast<size_t>(std::lround(options_.dynamic.long_baseline_s /
+                                                            std::max(period, 1e-3))));
     const LidarFrameFeatures* current;
     STCALIB_RETURN_IF_ERROR(Get(frame, &current));
     for (size_t gap : {size_t{1}, back}) {
@@ -162,9 +166,8 @@ Status BuildLocalMap(const Drive& drive, const DriveMotion& motion, size_t frame
   STCALIB_RETURN_IF_ERROR(drive.CheckFrame(frame));
   if (map_options.sweeps < 1) return Status::Error("local map: sweeps must be >= 1");
   *stats = LocalMapStats();
-  const size_t first = frame + 1 >= static_cast<size_t>(map_options.sweeps)
-                           ? frame + 1 - map_options.sweeps
-                           : 0;
+  const size_t first =
+      frame + 1 >= static_cast<size_t>(map_options.sweeps) ? frame + 1 - map_options.sweeps : 0;
   BaseCache cache(drive, motion, options);
   std::vector<LidarFrameFeatures> sweeps;
   for (size_t k = first; k <= frame; ++k) {

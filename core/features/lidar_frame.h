@@ -23,14 +23,14 @@ struct LidarFeatureOptions {
 
 // Everything the calibrator needs from one sweep, in the LiDAR frame at the sweep stamp.
 struct LidarFrameFeatures {
-  LidarScan scan;                          ///< as read (scan order, capture-time geometry)
-  double stamp_s = 0;                      ///< LiDAR stamp, DriveMotion seconds
+  LidarScan scan;      ///< as read (scan order, capture-time geometry)
+  double stamp_s = 0;  ///< LiDAR stamp, DriveMotion seconds
   ScanRings rings;
-  std::vector<double> point_time_s;        ///< capture time of each point relative to the stamp
-  std::vector<Eigen::Vector3d> deskewed;   ///< every point moved to the stamp
+  std::vector<double> point_time_s;       ///< capture time of each point relative to the stamp
+  std::vector<Eigen::Vector3d> deskewed;  ///< every point moved to the stamp
   GroundPlane ground_plane;
-  std::vector<uint8_t> ground;             ///< 1 = ground
-  DynamicFilterResult dynamic;             ///< empty `dynamic` when not run
+  std::vector<uint8_t> ground;  ///< 1 = ground
+  DynamicFilterResult dynamic;  ///< empty `dynamic` when not run
   LidarEdges edges;  ///< de-skewed to the stamp; time_s keeps each point's capture offset
 };
 

@@ -9,7 +9,9 @@ std::vector<bool> KeepNonIsolated(const std::vector<Eigen::Vector2d>& pixels, do
   std::vector<bool> keep(pixels.size(), false);
   if (pixels.size() < 2 || !(radius_px > 0)) return keep;
   // Hash grid with cells of the radius: neighbours lie in the 3×3 cells around.
-  auto key = [](int cx, int cy) { return (static_cast<int64_t>(cx) << 32) ^ static_cast<uint32_t>(cy); };
+  auto key = [](int cx, int cy) {
+    return (static_cast<int64_t>(cx) << 32) ^ static_cast<uint32_t>(cy);
+  };
   std::unordered_map<int64_t, std::vector<int>> grid;
   grid.reserve(pixels.size());
   std::vector<std::pair<int, int>> cells(pixels.size());

@@ -1,9 +1,9 @@
 #include "core/io/drive.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <filesystem>
-
-#include <glog/logging.h>
 
 #include "core/io/image.h"
 
@@ -95,10 +95,11 @@ Status OpenDrive(const std::string& drive_dir_in, const std::string& calib_dir_i
   std::string drive_dir = drive_dir_in;
   while (drive_dir.size() > 1 && drive_dir.back() == '/') drive_dir.pop_back();
   if (drive_dir.empty()) return Status::Error("no drive folder given (--drive)");
-  if (!fs::is_directory(drive_dir, ec)) return Status::Error(drive_dir + ": drive folder not found");
+  if (!fs::is_directory(drive_dir, ec))
+    return Status::Error(drive_dir + ": drive folder not found");
   drive->drive_dir = drive_dir;
-  drive->calib_dir = calib_dir_in.empty() ? fs::path(drive_dir).parent_path().string()
-                                          : calib_dir_in;
+  drive->calib_dir =
+      calib_dir_in.empty() ? fs::path(drive_dir).parent_path().string() : calib_dir_in;
   if (drive->calib_dir.empty()) drive->calib_dir = ".";
 
   const std::string image_dir = drive_dir + "/image_02";

@@ -1,7 +1,6 @@
 #include "core/io/image.h"
 
 #include <filesystem>
-
 #include <opencv2/imgcodecs.hpp>
 
 namespace stcalib {
@@ -17,7 +16,8 @@ Status ReadImage(const std::string& path, cv::Mat* image_bgr) {
   } catch (const cv::Exception& e) {
     return Status::Error(path + ": cannot decode image: " + e.what());
   }
-  if (image.empty()) return Status::Error(path + ": cannot decode image (unreadable or not an image)");
+  if (image.empty())
+    return Status::Error(path + ": cannot decode image (unreadable or not an image)");
   *image_bgr = image;
   return Status::Ok();
 }

@@ -1,11 +1,10 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <map>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/types/status.h"
 #include "core/types/transform.h"

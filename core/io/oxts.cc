@@ -11,10 +11,10 @@ namespace {
 // Field order of oxts/dataformat.txt; the last five are integers.
 template <typename Packet, typename Visitor>
 void VisitFields(Packet& p, Visitor&& visit) {
-  double* reals[] = {&p.lat, &p.lon, &p.alt, &p.roll, &p.pitch, &p.yaw, &p.vn, &p.ve,
-                     &p.vf,  &p.vl,  &p.vu,  &p.ax,   &p.ay,    &p.az,  &p.af, &p.al,
-                     &p.au,  &p.wx,  &p.wy,  &p.wz,   &p.wf,    &p.wl,  &p.wu, &p.pos_accuracy,
-                     &p.vel_accuracy};
+  double* reals[] = {&p.lat, &p.lon, &p.alt,          &p.roll,        &p.pitch, &p.yaw, &p.vn,
+                     &p.ve,  &p.vf,  &p.vl,           &p.vu,          &p.ax,    &p.ay,  &p.az,
+                     &p.af,  &p.al,  &p.au,           &p.wx,          &p.wy,    &p.wz,  &p.wf,
+                     &p.wl,  &p.wu,  &p.pos_accuracy, &p.vel_accuracy};
   int* integers[] = {&p.navstat, &p.numsats, &p.posmode, &p.velmode, &p.orimode};
   for (double* r : reals) visit(r, nullptr);
   for (int* i : integers) visit(nullptr, i);

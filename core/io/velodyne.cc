@@ -61,8 +61,7 @@ Status ReadVelodyneBin(const std::string& path, LidarScan* scan) {
         !std::isfinite(v[3])) {
       scan->points_lidar.clear();
       scan->reflectance.clear();
-      return Status::Error(path + ": point " + std::to_string(i) +
-                           " has a NaN or infinite value");
+      return Status::Error(path + ": point " + std::to_string(i) + " has a NaN or infinite value");
     }
     scan->points_lidar[i] = Eigen::Vector3d(v[0], v[1], v[2]);
     scan->reflectance[i] = v[3];

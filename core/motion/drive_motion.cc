@@ -35,8 +35,9 @@ double SweepDurationSeconds(const Drive& drive) {
     if (sum > 0) return sum / n;
   }
   if (n >= 2) {
-    const double period = NsToSeconds(drive.lidar_stamps_ns.back() - drive.lidar_stamps_ns.front()) /
-                          static_cast<double>(n - 1);
+    const double period =
+        NsToSeconds(drive.lidar_stamps_ns.back() - drive.lidar_stamps_ns.front()) /
+        static_cast<double>(n - 1);
     if (period > 0) return period;
   }
   return 0.1;

@@ -16,7 +16,9 @@ class DriveMotion {
 
   Rigid3d T_world_lidar(double t_s) const;
   LidarPoseFunction PoseFunction() const;
-  double Seconds(StampNs stamp_ns) const { return NsToSeconds(stamp_ns - trajectory_.reference_ns()); }
+  double Seconds(StampNs stamp_ns) const {
+    return NsToSeconds(stamp_ns - trajectory_.reference_ns());
+  }
   const OxtsTrajectory& trajectory() const { return trajectory_; }
 
  private:

@@ -1,8 +1,8 @@
 #include "core/motion/oxts_poses.h"
 
-#include <cmath>
-
 #include <glog/logging.h>
+
+#include <cmath>
 
 namespace stcalib {
 namespace {
@@ -28,7 +28,8 @@ Eigen::Matrix3d OxtsAttitude(const OxtsPacket& packet) {
 
 Rigid3d OxtsPose(const OxtsOrigin& origin, const OxtsPacket& packet) {
   const Eigen::Vector2d xy = MercatorOffset(origin, packet.lat, packet.lon);
-  return MakeRigid(OxtsAttitude(packet), Eigen::Vector3d(xy.x(), xy.y(), packet.alt - origin.alt_m));
+  return MakeRigid(OxtsAttitude(packet),
+                   Eigen::Vector3d(xy.x(), xy.y(), packet.alt - origin.alt_m));
 }
 
 std::vector<Eigen::Vector3d> IntegrateOxtsVelocities(const std::vector<OxtsPacket>& packets,

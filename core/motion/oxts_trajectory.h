@@ -17,8 +17,8 @@ namespace stcalib {
 class OxtsTrajectory {
  public:
   // Stamps must increase strictly; errors name the offending packet.
-  static Status Create(const std::vector<OxtsPacket>& packets, const std::vector<StampNs>& stamps_ns,
-                       OxtsTrajectory* trajectory);
+  static Status Create(const std::vector<OxtsPacket>& packets,
+                       const std::vector<StampNs>& stamps_ns, OxtsTrajectory* trajectory);
 
   Rigid3d T_world_imu(StampNs stamp_ns) const;
   Rigid3d T_world_imu_s(double seconds_since_reference) const;

@@ -1,8 +1,7 @@
 #pragma once
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "core/types/status.h"
 #include "core/types/transform.h"
@@ -12,11 +11,11 @@ namespace stcalib {
 // Scan registration with PCL, behind an Eigen-only interface: PCL headers stay in
 // registration.cc, the one translation unit that pays their compile time.
 struct NdtOptions {
-  double resolution_m = 1.0;    ///< NDT cell size [m]
-  double step_size_m = 0.1;     ///< More–Thuente maximum step [m]
-  double epsilon = 0.01;        ///< transformation change that ends the iterations
+  double resolution_m = 1.0;  ///< NDT cell size [m]
+  double step_size_m = 0.1;   ///< More–Thuente maximum step [m]
+  double epsilon = 0.01;      ///< transformation change that ends the iterations
   int max_iterations = 35;
-  double voxel_m = 0.4;         ///< both clouds are voxel-downsampled first [m]; 0 = no
+  double voxel_m = 0.4;  ///< both clouds are voxel-downsampled first [m]; 0 = no
 };
 
 struct IcpOptions {
@@ -33,11 +32,13 @@ struct RegistrationResult {
 };
 
 Status RegisterNdt(const std::vector<Eigen::Vector3d>& source,
-                   const std::vector<Eigen::Vector3d>& target, const Rigid3d& initial_T_target_source,
-                   const NdtOptions& options, RegistrationResult* result);
+                   const std::vector<Eigen::Vector3d>& target,
+                   const Rigid3d& initial_T_target_source, const NdtOptions& options,
+                   RegistrationResult* result);
 
 Status RegisterIcp(const std::vector<Eigen::Vector3d>& source,
-                   const std::vector<Eigen::Vector3d>& target, const Rigid3d& initial_T_target_source,
-                   const IcpOptions& options, RegistrationResult* result);
+                   const std::vector<Eigen::Vector3d>& target,
+                   const Rigid3d& initial_T_target_source, const IcpOptions& options,
+                   RegistrationResult* result);
 
 }  // namespace stcalib

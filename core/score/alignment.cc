@@ -32,8 +32,8 @@ AlignmentStats Measure(const std::vector<ProjectedPoint>& projected, const MapOf
   }
   stats.kept = static_cast<int>(distances.size());
   if (distances.empty()) return stats;
-  stats.aligned = static_cast<int>(std::count_if(
-      distances.begin(), distances.end(), [&](float d) { return d <= threshold_px; }));
+  stats.aligned = static_cast<int>(std::count_if(distances.begin(), distances.end(),
+                                                 [&](float d) { return d <= threshold_px; }));
   stats.rate = static_cast<double>(stats.aligned) / stats.kept;
   std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
   stats.median_distance_px = distances[distances.size() / 2];
@@ -59,7 +59,7 @@ AlignmentStats MeasureOrientedAlignment(const std::vector<ProjectedPoint>& proje
       projected,
       [&](size_t i) -> const cv::Mat& {
         return kinds[projected[i].index] == EdgeKind::kVertical ? distance_vertical_raw_px
-                                                                 : distance_horizontal_raw_px;
+                                                                : distance_horizontal_raw_px;
       },
       threshold_px, isolation_radius_px);
 }

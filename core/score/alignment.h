@@ -1,8 +1,7 @@
 #pragma once
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "core/features/lidar_edges.h"
 #include "core/score/projection.h"
@@ -10,10 +9,10 @@
 namespace stcalib {
 
 struct AlignmentStats {
-  int projected = 0;         ///< edge points projected into the image
-  int kept = 0;              ///< after the isolated-point kernel
-  int aligned = 0;           ///< kept points within the threshold of an image edge
-  double rate = 0;           ///< aligned / kept
+  int projected = 0;  ///< edge points projected into the image
+  int kept = 0;       ///< after the isolated-point kernel
+  int aligned = 0;    ///< kept points within the threshold of an image edge
+  double rate = 0;    ///< aligned / kept
   double median_distance_px = 0;
 };
 

@@ -1,8 +1,7 @@
 #pragma once
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "core/io/kitti_calib.h"
 #include "core/types/transform.h"
@@ -14,8 +13,8 @@ namespace stcalib {
 struct CameraModel {
   Eigen::Matrix3d R_rect_00 = Eigen::Matrix3d::Identity();
   Eigen::Matrix<double, 3, 4> P_rect_02 = Eigen::Matrix<double, 3, 4>::Zero();
-  int width = 0;   ///< [px], read from the image or S_rect_02, never assumed
-  int height = 0;  ///< [px]
+  int width = 0;             ///< [px], read from the image or S_rect_02, never assumed
+  int height = 0;            ///< [px]
   double min_depth_m = 0.5;  ///< points nearer than this (rectified z) are not projected [m]
 
   static CameraModel FromCalibration(const CameraCalibration& calibration, int width, int height);

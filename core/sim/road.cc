@@ -5,8 +5,7 @@
 
 namespace stcalib::sim {
 
-SimRoad SimRoad::Generate(double s_begin_m, double s_end_m, bool with_turns,
-                          std::mt19937_64* rng) {
+SimRoad SimRoad::Generate(double s_begin_m, double s_end_m, bool with_turns, std::mt19937_64* rng) {
   SimRoad road;
   road.s_begin_ = s_begin_m;
   const int n = static_cast<int>(std::ceil((s_end_m - s_begin_m) / road.ds_)) + 1;

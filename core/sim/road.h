@@ -1,9 +1,8 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <random>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace stcalib::sim {
 

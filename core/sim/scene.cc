@@ -7,11 +7,11 @@
 namespace stcalib::sim {
 namespace {
 
-constexpr double kRightKerbM = -4.0;   ///< right road edge (parking strip beyond the lane)
-constexpr double kLeftKerbM = 5.5;     ///< left road edge (beyond the oncoming lane)
+constexpr double kRightKerbM = -4.0;  ///< right road edge (parking strip beyond the lane)
+constexpr double kLeftKerbM = 5.5;    ///< left road edge (beyond the oncoming lane)
 constexpr double kSidewalkHeightM = 0.15;
-constexpr double kRightFrontM = 9.0;   ///< nearest building front, right side (|lateral|)
-constexpr double kLeftFrontM = 10.0;   ///< nearest building front, left side
+constexpr double kRightFrontM = 9.0;  ///< nearest building front, right side (|lateral|)
+constexpr double kLeftFrontM = 10.0;  ///< nearest building front, left side
 
 Shape Box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int material) {
   Shape s;
@@ -135,18 +135,25 @@ Eigen::Vector3d RandomColour(std::mt19937_64* rng, double lo, double hi) {
 }  // namespace
 
 bool ParseSceneType(const std::string& name, SceneType* type) {
-  if (name == "urban") *type = SceneType::kUrban;
-  else if (name == "poles") *type = SceneType::kPoles;
-  else if (name == "open") *type = SceneType::kOpen;
-  else return false;
+  if (name == "urban")
+    *type = SceneType::kUrban;
+  else if (name == "poles")
+    *type = SceneType::kPoles;
+  else if (name == "open")
+    *type = SceneType::kOpen;
+  else
+    return false;
   return true;
 }
 
 std::string SceneTypeName(SceneType type) {
   switch (type) {
-    case SceneType::kUrban: return "urban";
-    case SceneType::kPoles: return "poles";
-    case SceneType::kOpen: return "open";
+    case SceneType::kUrban:
+      return "urban";
+    case SceneType::kPoles:
+      return "poles";
+    case SceneType::kOpen:
+      return "open";
   }
   return "?";
 }
@@ -199,9 +206,9 @@ int Scene::AddMaterial(const Material& m) {
 void Scene::AddObject(SceneObject object) {
   object.UpdateBounds();
   if (object.moving) {
-    max_object_speed_ = std::max(
-        max_object_speed_,
-        std::abs(object.speed) + (object.follows_ego ? SimTrajectory::kMaxSpeedMps : 0.0));
+    max_object_speed_ =
+        std::max(max_object_speed_,
+                 std::abs(object.speed) + (object.follows_ego ? SimTrajectory::kMaxSpeedMps : 0.0));
   }
   objects_.push_back(std::move(object));
 }
@@ -317,13 +324,11 @@ class SceneBuilder {
       SceneObject o = RoadsideObject(s, "pole");
       const bool sign = with_signs && U(0, 1) < 0.4;
       if (sign) {
-        const int plate = Mat(U(0, 1) < 0.5 ? Eigen::Vector3d(0.7, 0.3, 0.1)
-                                            : Eigen::Vector3d(0.1, 0.1, 0.75),
-                              0.9);
+        const int plate = Mat(
+            U(0, 1) < 0.5 ? Eigen::Vector3d(0.7, 0.3, 0.1) : Eigen::Vector3d(0.1, 0.1, 0.75), 0.9);
         o.shapes.push_back(Cylinder(0, lateral, 0.04, 0, 2.6, metal));
-        o.shapes.push_back(
-            Box(Eigen::Vector3d(-0.03, lateral - 0.35, 2.0), Eigen::Vector3d(0.03, lateral + 0.35, 2.7),
-                plate));
+        o.shapes.push_back(Box(Eigen::Vector3d(-0.03, lateral - 0.35, 2.0),
+                               Eigen::Vector3d(0.03, lateral + 0.35, 2.7), plate));
         o.name = "sign";
       } else {
         o.shapes.push_back(Cylinder(0, lateral, U(0.07, 0.13), 0, U(5, 8), metal));
@@ -340,8 +345,8 @@ class SceneBuilder {
       const double trunk_h = U(2.2, 3.5), crown_r = U(1.4, 2.6);
       o.shapes.push_back(Cylinder(0, lateral, U(0.14, 0.28), 0, trunk_h + 0.3, bark));
       if (with_crowns) {
-        const int leaves = Mat(Eigen::Vector3d(U(0.1, 0.2), U(0.35, 0.55), U(0.15, 0.3)), 0.35,
-                               Texture::kFoliage);
+        const int leaves =
+            Mat(Eigen::Vector3d(U(0.1, 0.2), U(0.35, 0.55), U(0.15, 0.3)), 0.35, Texture::kFoliage);
         o.shapes.push_back(
             Sphere(Eigen::Vector3d(0, lateral, trunk_h + 0.9 * crown_r), crown_r, leaves));
       }
@@ -400,13 +405,13 @@ class SceneBuilder {
         const int skin = Mat(Eigen::Vector3d(0.55, 0.65, 0.8), 0.3);
         // Standing on the sidewalk, in the walking lanes clear of poles and tree trunks.
         const double z0 = kSidewalkHeightM;
-        o.shapes.push_back(Box(Eigen::Vector3d(-0.15, -0.2, z0),
-                               Eigen::Vector3d(0.15, 0.2, z0 + 1.45), cloth));
+        o.shapes.push_back(
+            Box(Eigen::Vector3d(-0.15, -0.2, z0), Eigen::Vector3d(0.15, 0.2, z0 + 1.45), cloth));
         o.shapes.push_back(Sphere(Eigen::Vector3d(0, 0, z0 + 1.62), 0.13, skin));
         o.name = "pedestrian";
         const bool right = U(0, 1) < 0.5, inner = U(0, 1) < 0.5;
-        o.lateral = right ? (inner ? -U(5.3, 5.5) : -U(7.0, 8.0))
-                          : (inner ? U(6.7, 6.9) : U(8.8, 9.5));
+        o.lateral =
+            right ? (inner ? -U(5.3, 5.5) : -U(7.0, 8.0)) : (inner ? U(6.7, 6.9) : U(8.8, 9.5));
         o.s0 = s_start + U(-5, 50);
         const bool forward = U(0, 1) < 0.5;
         o.speed = (forward ? 1.0 : -1.0) * U(1.0, 1.6);
@@ -535,9 +540,9 @@ bool Scene::Intersect(const AzimuthIndex& index, const Eigen::Vector3d& origin,
     for (const Shape& shape : o.shapes) {
       Eigen::Vector3d normal_local;
       if (IntersectShape(shape, o_local, d_local, inv_d, &best, &normal_local)) {
-        hit->normal_world = Eigen::Vector3d(c * normal_local.x() - s * normal_local.y(),
-                                            s * normal_local.x() + c * normal_local.y(),
-                                            normal_local.z());
+        hit->normal_world =
+            Eigen::Vector3d(c * normal_local.x() - s * normal_local.y(),
+                            s * normal_local.x() + c * normal_local.y(), normal_local.z());
         hit->material = shape.material;
         hit->object = i;
         found = true;

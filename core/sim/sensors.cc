@@ -13,19 +13,26 @@ constexpr double kEarthRadiusM = 6378137.0;
 uint8_t LabelOf(const Scene& scene, int object) {
   if (object < 0) return static_cast<uint8_t>(PointLabel::kGround);
   switch (scene.objects()[object].object_class) {
-    case ObjectClass::kGround: return static_cast<uint8_t>(PointLabel::kGround);
-    case ObjectClass::kMoving: return static_cast<uint8_t>(PointLabel::kDynamic);
-    case ObjectClass::kStructure: break;
+    case ObjectClass::kGround:
+      return static_cast<uint8_t>(PointLabel::kGround);
+    case ObjectClass::kMoving:
+      return static_cast<uint8_t>(PointLabel::kDynamic);
+    case ObjectClass::kStructure:
+      break;
   }
   return static_cast<uint8_t>(PointLabel::kStatic);
 }
 
 double TextureGain(const Material& m, const Eigen::Vector3d& p) {
   switch (m.texture) {
-    case Texture::kPlain: return 1.0;
-    case Texture::kFoliage: return 0.35 + 1.0 * CellNoise(p, 0.07);
-    case Texture::kAsphalt: return 0.88 + 0.24 * CellNoise(p, 0.04);
-    case Texture::kFacade: return 0.95 + 0.1 * CellNoise(p, 0.25);
+    case Texture::kPlain:
+      return 1.0;
+    case Texture::kFoliage:
+      return 0.35 + 1.0 * CellNoise(p, 0.07);
+    case Texture::kAsphalt:
+      return 0.88 + 0.24 * CellNoise(p, 0.04);
+    case Texture::kFacade:
+      return 0.95 + 0.1 * CellNoise(p, 0.25);
   }
   return 1.0;
 }
@@ -105,8 +112,8 @@ SimulatedSweep SimulateLidarSweep(const Scene& scene, const SimTrajectory& traje
   return sweep;
 }
 
-cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory,
-                          const CameraRig& rig, double t_s, std::mt19937_64* rng) {
+cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, const CameraRig& rig,
+                          double t_s, std::mt19937_64* rng) {
   const Rigid3d T_world_camera = trajectory.T_world_imu(t_s) * rig.T_imu_camera;
   const Eigen::Matrix3d K = rig.P_rect_02.leftCols<3>();
   const Eigen::Matrix3d K_inv = K.inverse();
@@ -129,7 +136,8 @@ cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory,
       RayHit hit;
       if (scene.Intersect(index, origin, dir, t_s, kMaxRange, &hit)) {
         const Material& m = scene.materials()[hit.material];
-        const double shade = kAmbient + kDiffuse * std::max(0.0, hit.normal_world.dot(rig.sun_world));
+        const double shade =
+            kAmbient + kDiffuse * std::max(0.0, hit.normal_world.dot(rig.sun_world));
         colour = m.albedo_bgr * (shade * TextureGain(m, hit.point_world));
       } else {
         const double k = std::clamp(dir.z() * 3.0, 0.0, 1.0);
@@ -164,7 +172,8 @@ OxtsPacket SynthesizeOxtsPacket(const SimTrajectory& trajectory, const OxtsOrigi
   // Invert the Mercator projection of oxts_poses.h (scale of the origin latitude).
   const double scale = std::cos(origin.lat_deg * M_PI / 180.0);
   const double x0 = scale * kEarthRadiusM * origin.lon_deg * M_PI / 180.0;
-  const double y0 = scale * kEarthRadiusM * std::log(std::tan(M_PI * (90.0 + origin.lat_deg) / 360.0));
+  const double y0 =
+      scale * kEarthRadiusM * std::log(std::tan(M_PI * (90.0 + origin.lat_deg) / 360.0));
   const double x = T1.translation().x() + n_pos(*rng) + x0;
   const double y = T1.translation().y() + n_pos(*rng) + y0;
   p.lon = x / (scale * kEarthRadiusM) * 180.0 / M_PI;

@@ -1,10 +1,9 @@
 #pragma once
 
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <random>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/io/oxts.h"
 #include "core/io/velodyne.h"
@@ -22,10 +21,10 @@ struct LidarModel {
   double elevation_lower_top_deg = -8.83;
   double elevation_bottom_deg = -24.9;
   int beams = 64;
-  double azimuth_step_deg = 0.09;  ///< [deg]
-  double range_noise_m = 0.02;     ///< Gaussian σ [m]
-  double max_range_m = 120.0;      ///< [m]
-  double min_range_m = 2.0;        ///< returns nearer than this are dropped [m]
+  double azimuth_step_deg = 0.09;       ///< [deg]
+  double range_noise_m = 0.02;          ///< Gaussian σ [m]
+  double max_range_m = 120.0;           ///< [m]
+  double min_range_m = 2.0;             ///< returns nearer than this are dropped [m]
   double foliage_penetration_m = 0.35;  ///< returns in tree crowns land up to this deep [m]
 
   double ElevationDeg(int beam) const;  ///< beam 0 is the top one
@@ -54,8 +53,8 @@ struct CameraRig {
 };
 
 // Renders image_02 at time t_s (global shutter) by ray casting through P_rect_02 and R_rect_00.
-cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory,
-                          const CameraRig& rig, double t_s, std::mt19937_64* rng);
+cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, const CameraRig& rig,
+                          double t_s, std::mt19937_64* rng);
 
 // An oxts packet of the true motion at t_s with measurement noise.
 OxtsPacket SynthesizeOxtsPacket(const SimTrajectory& trajectory, const OxtsOrigin& origin,

@@ -1,10 +1,10 @@
 #include "core/sim/simulator.h"
 
-#include <cmath>
-#include <filesystem>
+#include <glog/logging.h>
 #include <unistd.h>
 
-#include <glog/logging.h>
+#include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "core/io/image.h"
@@ -17,8 +17,16 @@ namespace {
 namespace fs = std::filesystem;
 
 // Independent random streams per purpose and frame, so that any frame can be simulated alone.
-enum Stream : uint64_t { kRoad = 1, kTrajectory, kScene, kCalibration, kFrameLidar, kFrameCamera,
-                         kFrameOxts, kFrameClock };
+enum Stream : uint64_t {
+  kRoad = 1,
+  kTrajectory,
+  kScene,
+  kCalibration,
+  kFrameLidar,
+  kFrameCamera,
+  kFrameOxts,
+  kFrameClock
+};
 
 std::mt19937_64 MakeRng(uint64_t seed, uint64_t stream, uint64_t frame = 0) {
   std::seed_seq seq{static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32),
@@ -117,21 +125,20 @@ Simulator::Simulator(const SimulatorOptions& options) : options_(options) {
   std::mt19937_64 road_rng = MakeRng(seed, kRoad);
   // Speed is at most 15 m/s; leave 150 m of scenery beyond the last frame and 80 m behind.
   const double duration = LidarMidTime(options.frames - 1) + 1.0;
-  road_ = std::make_unique<SimRoad>(SimRoad::Generate(
-      -80.0, SimTrajectory::kMaxSpeedMps * duration + 150.0,
-      /*with_turns=*/true, &road_rng));
+  road_ = std::make_unique<SimRoad>(
+      SimRoad::Generate(-80.0, SimTrajectory::kMaxSpeedMps * duration + 150.0,
+                        /*with_turns=*/true, &road_rng));
   std::mt19937_64 trajectory_rng = MakeRng(seed, kTrajectory);
   trajectory_ = std::make_unique<SimTrajectory>(road_.get(), &trajectory_rng);
   std::mt19937_64 scene_rng = MakeRng(seed, kScene);
-  scene_ = std::make_unique<Scene>(Scene::Build(options.scene, options.dynamic_objects,
-                                                road_.get(), trajectory_.get(), &scene_rng));
+  scene_ = std::make_unique<Scene>(Scene::Build(options.scene, options.dynamic_objects, road_.get(),
+                                                trajectory_.get(), &scene_rng));
 
   std::mt19937_64 calib_rng = MakeRng(seed, kCalibration);
   std::uniform_real_distribution<double> angle(-0.5, 0.5), offset(-0.02, 0.02);
   const Eigen::Vector3d rpy_deg(angle(calib_rng), angle(calib_rng), angle(calib_rng));
   T_camera_lidar_ = NominalTCameraLidar();
-  T_camera_lidar_.linear() =
-      T_camera_lidar_.linear() * ExpSO3(rpy_deg * M_PI / 180.0);
+  T_camera_lidar_.linear() = T_camera_lidar_.linear() * ExpSO3(rpy_deg * M_PI / 180.0);
   T_camera_lidar_.translation() +=
       Eigen::Vector3d(offset(calib_rng), offset(calib_rng), offset(calib_rng));
   T_lidar_imu_ = NominalTLidarImu();
@@ -139,13 +146,13 @@ Simulator::Simulator(const SimulatorOptions& options) : options_(options) {
   rig_.R_rect_00 << 9.999239e-01, 9.837760e-03, -7.445048e-03, -9.869795e-03, 9.999421e-01,
       -4.278459e-03, 7.402527e-03, 4.351614e-03, 9.999631e-01;
   rig_.R_rect_00 = Eigen::Quaterniond(rig_.R_rect_00).normalized().toRotationMatrix();
-  rig_.P_rect_02 << 7.215377e+02, 0.0, 6.095593e+02, 4.485728e+01, 0.0, 7.215377e+02,
-      1.728540e+02, 2.163791e-01, 0.0, 0.0, 1.0, 2.745884e-03;
+  rig_.P_rect_02 << 7.215377e+02, 0.0, 6.095593e+02, 4.485728e+01, 0.0, 7.215377e+02, 1.728540e+02,
+      2.163791e-01, 0.0, 0.0, 1.0, 2.745884e-03;
   rig_.T_imu_camera = T_lidar_imu_.inverse() * T_camera_lidar_.inverse();
   std::uniform_real_distribution<double> sun_azimuth(0, 2 * M_PI), sun_elevation(0.6, 1.1);
   const double az = sun_azimuth(calib_rng), el = sun_elevation(calib_rng);
-  rig_.sun_world = Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
-                                   std::sin(el));
+  rig_.sun_world =
+      Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
   std::uniform_real_distribution<double> lat(48.9, 49.1), lon(8.3, 8.5), alt(100, 130);
   origin_ = {lat(calib_rng), lon(calib_rng), alt(calib_rng)};
   // 2026-01-01 12:00:00 UTC plus one day per seed (mod a year).
@@ -214,8 +221,7 @@ SimulatedFrame Simulator::SimulateFrame(int frame) const {
 }
 
 Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& out_dir,
-                           std::string* drive_dir,
-                           const std::function<void(int, int)>& progress) {
+                           std::string* drive_dir, const std::function<void(int, int)>& progress) {
   STCALIB_RETURN_IF_ERROR(options.Validate());
   if (out_dir.empty()) return Status::Error("no output folder given (--out)");
   const Simulator simulator(options);
@@ -236,8 +242,8 @@ Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& o
   fs::remove_all(partial, ec);
   const std::string drive_name = date + "_drive_0001_sync";
   const fs::path drive = partial / drive_name;
-  for (const char* sub : {"image_02/data", "velodyne_points/data", "velodyne_points/labels",
-                          "oxts/data"}) {
+  for (const char* sub :
+       {"image_02/data", "velodyne_points/data", "velodyne_points/labels", "oxts/data"}) {
     fs::create_directories(drive / sub, ec);
     if (ec) {
       fs::remove_all(partial, ec);
@@ -247,7 +253,8 @@ Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& o
 
   auto write_all = [&]() -> Status {
     const std::string d = drive.string();
-    STCALIB_RETURN_IF_ERROR(simulator.CameraCalibFile().Write((partial / "calib_cam_to_cam.txt").string()));
+    STCALIB_RETURN_IF_ERROR(
+        simulator.CameraCalibFile().Write((partial / "calib_cam_to_cam.txt").string()));
     STCALIB_RETURN_IF_ERROR(
         WriteVeloToCam((partial / "calib_velo_to_cam.txt").string(), simulator.T_camera_lidar()));
     STCALIB_RETURN_IF_ERROR(
@@ -296,8 +303,11 @@ Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& o
     nlohmann::json moving = nlohmann::json::array();
     for (const SceneObject& o : simulator.scene().objects()) {
       if (!o.moving) continue;
-      moving.push_back({{"class", o.name}, {"s0_m", o.s0}, {"speed_mps", o.speed},
-                        {"lateral_m", o.lateral}, {"follows_ego", o.follows_ego}});
+      moving.push_back({{"class", o.name},
+                        {"s0_m", o.s0},
+                        {"speed_mps", o.speed},
+                        {"lateral_m", o.lateral},
+                        {"follows_ego", o.follows_ego}});
     }
     const nlohmann::json truth = {
         {"generator", "stcalib simulate"},

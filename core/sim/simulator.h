@@ -3,9 +3,8 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "core/io/kitti_calib.h"
 #include "core/io/timestamps.h"
@@ -19,10 +18,10 @@
 namespace stcalib::sim {
 
 struct SimulatorOptions {
-  int frames = 40;                 ///< frames to simulate (camera, LiDAR and oxts each)
-  uint64_t seed = 1;               ///< everything random derives from it
-  double time_offset_s = 0.0;      ///< δ: LiDAR stamps = true mid-sweep time − δ [s]
-  int dynamic_objects = 6;         ///< moving vehicles and pedestrians
+  int frames = 40;             ///< frames to simulate (camera, LiDAR and oxts each)
+  uint64_t seed = 1;           ///< everything random derives from it
+  double time_offset_s = 0.0;  ///< δ: LiDAR stamps = true mid-sweep time − δ [s]
+  int dynamic_objects = 6;     ///< moving vehicles and pedestrians
   SceneType scene = SceneType::kUrban;
   double lidar_hz = 10.0;          ///< spin rate = frame rate of every sensor [Hz]
   double camera_delay_s = 0.0105;  ///< camera exposure after the LiDAR faces forward [s]
@@ -35,8 +34,8 @@ struct FrameTiming {
   double camera_time_s = 0;     ///< true capture time of the image (= its stamp) [s]
   double lidar_mid_time_s = 0;  ///< true time the LiDAR faces forward [s]
   double oxts_time_s = 0;       ///< true time of the oxts packet (= its stamp) [s]
-  StampNs camera_stamp_ns = 0, lidar_stamp_ns = 0, lidar_start_stamp_ns = 0,
-          lidar_end_stamp_ns = 0, oxts_stamp_ns = 0;
+  StampNs camera_stamp_ns = 0, lidar_stamp_ns = 0, lidar_start_stamp_ns = 0, lidar_end_stamp_ns = 0,
+          oxts_stamp_ns = 0;
 };
 
 struct SimulatedFrame : FrameTiming {
@@ -54,7 +53,7 @@ class Simulator {
 
   SimulatedFrame SimulateFrame(int frame) const;
   FrameTiming Timing(int frame) const;
-  OxtsPacket SimulateOxts(int frame) const;      ///< the packet of SimulateFrame(frame), alone
+  OxtsPacket SimulateOxts(int frame) const;       ///< the packet of SimulateFrame(frame), alone
   SimulatedSweep SimulateSweep(int frame) const;  ///< the sweep of SimulateFrame(frame), alone
 
   const SimulatorOptions& options() const { return options_; }

@@ -5,8 +5,8 @@
 namespace stcalib::sim {
 
 SimTrajectory::SimTrajectory(const SimRoad* road, std::mt19937_64* rng) : road_(road) {
-  std::uniform_real_distribution<double> mean(10.0, 13.0), amplitude(1.0, 2.0),
-      period(6.0, 12.0), phase(0.0, 2 * M_PI);
+  std::uniform_real_distribution<double> mean(10.0, 13.0), amplitude(1.0, 2.0), period(6.0, 12.0),
+      phase(0.0, 2 * M_PI);
   v_mean_ = mean(*rng);
   v_amplitude_ = amplitude(*rng);
   v_period_ = period(*rng);

@@ -32,8 +32,8 @@ class Status {
 }  // namespace stcalib
 
 // Returns from the enclosing function when `expr` yields a non-ok Status.
-#define STCALIB_RETURN_IF_ERROR(expr)          \
-  do {                                         \
-    ::stcalib::Status _stcalib_status = (expr); \
+#define STCALIB_RETURN_IF_ERROR(expr)                  \
+  do {                                                 \
+    ::stcalib::Status _stcalib_status = (expr);        \
     if (!_stcalib_status.ok()) return _stcalib_status; \
   } while (0)

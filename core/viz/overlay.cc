@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/imgproc.hpp>
 
 namespace stcalib {
@@ -28,14 +27,16 @@ cv::Mat RenderDepthOverlay(const cv::Mat& image_bgr, const std::vector<Projected
   std::vector<const ProjectedPoint*> order;
   order.reserve(points.size());
   for (const ProjectedPoint& p : points) order.push_back(&p);
-  std::sort(order.begin(), order.end(),
-            [](const ProjectedPoint* a, const ProjectedPoint* b) { return a->depth_m > b->depth_m; });
+  std::sort(order.begin(), order.end(), [](const ProjectedPoint* a, const ProjectedPoint* b) {
+    return a->depth_m > b->depth_m;
+  });
   for (const ProjectedPoint* p : order) {
     const double s = std::clamp(
         std::log(options.max_depth_m / std::max(p->depth_m, 1e-3)) / log_range, 0.0, 1.0);
     const cv::Vec3b c = colours.at<cv::Vec3b>(0, static_cast<int>(std::lround(s * 255.0)));
-    cv::circle(canvas, cv::Point(static_cast<int>(std::lround(p->pixel.x())),
-                                 static_cast<int>(std::lround(p->pixel.y()))),
+    cv::circle(canvas,
+               cv::Point(static_cast<int>(std::lround(p->pixel.x())),
+                         static_cast<int>(std::lround(p->pixel.y()))),
                options.radius_px, cv::Scalar(c[0], c[1], c[2]), cv::FILLED, cv::LINE_8);
   }
   return canvas;
