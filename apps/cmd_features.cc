@@ -71,7 +71,7 @@ int RunFeatures() {
   const double camera_s = motion.Seconds(drive.camera_stamps_ns[frame]);
   const Rigid3d T_camera_lidar =
       drive.T_camera_lidar * RelativeLidarPose(motion.PoseFunction(), camera_s, lidar.stamp_s);
-  const CameraModel camera = CameraModel::FromCalibration(drive.camera, image.cols, image.rows);
+  const CameraModel camera = MakeCameraModel(drive.camera, image.cols, image.rows);
   const AlignmentStats oriented = MeasureOrientedAlignment(
       ProjectPoints(camera, T_camera_lidar, lidar.edges.points_lidar), lidar.edges.kind,
       image_features.distance_vertical_raw_px, image_features.distance_horizontal_raw_px, 3.0, 8.0);

@@ -25,7 +25,7 @@ int RunProject() {
   if (status.ok()) status = drive.LoadScan(frame, &scan);
   if (!status.ok()) return ReportError("project", status);
 
-  const CameraModel camera = CameraModel::FromCalibration(drive.camera, image.cols, image.rows);
+  const CameraModel camera = MakeCameraModel(drive.camera, image.cols, image.rows);
   const std::vector<ProjectedPoint> projected =
       ProjectPoints(camera, drive.T_camera_lidar, scan.points_lidar);
   status = WriteImage(FLAGS_out, RenderDepthOverlay(image, projected));

@@ -57,7 +57,7 @@ void BM_ProjectFrame(benchmark::State& state) {
   if (!OpenKitti(state, &drive)) return;
   LidarScan scan;
   if (!drive.LoadScan(0, &scan).ok()) return state.SkipWithError("cannot read scan");
-  const CameraModel camera = CameraModel::FromCalibration(drive.camera, drive.camera.image_width,
+  const CameraModel camera = MakeCameraModel(drive.camera, drive.camera.image_width,
                                                           drive.camera.image_height);
   for (auto _ : state) {
     benchmark::DoNotOptimize(ProjectPoints(camera, drive.T_camera_lidar, scan.points_lidar));

@@ -272,7 +272,7 @@ TEST(Alignment, KittiRateDropsWithTwoDegreesOfError) {
     const ImageFeatures image_features = ExtractImageFeatures(image, image_options);
     LidarFrameFeatures lidar;
     ASSERT_TRUE(LoadLidarFrameFeatures(drive, motion, frame, LidarFeatureOptions(), &lidar).ok());
-    const CameraModel camera = CameraModel::FromCalibration(drive.camera, image.cols, image.rows);
+    const CameraModel camera = MakeCameraModel(drive.camera, image.cols, image.rows);
     const Rigid3d T_motion = RelativeLidarPose(
         motion.PoseFunction(), motion.Seconds(drive.camera_stamps_ns[frame]), lidar.stamp_s);
     auto rates = [&](const Rigid3d& T_camera_lidar) {

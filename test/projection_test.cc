@@ -61,7 +61,7 @@ TEST(Projection, KittiFrameZeroLandsInsideTheImage) {
   LidarScan scan;
   ASSERT_TRUE(drive.LoadImage(0, &image).ok());
   ASSERT_TRUE(drive.LoadScan(0, &scan).ok());
-  const CameraModel camera = CameraModel::FromCalibration(drive.camera, image.cols, image.rows);
+  const CameraModel camera = MakeCameraModel(drive.camera, image.cols, image.rows);
   // In front: 5 m or more ahead, within ±35° of azimuth and −12°..+2° of elevation (inside the
   // camera's ±40° × −15°..+13° field of view, with margin).
   std::vector<Eigen::Vector3d> in_front;

@@ -2,8 +2,7 @@
 
 namespace stcalib {
 
-CameraModel CameraModel::FromCalibration(const CameraCalibration& calibration, int width,
-                                         int height) {
+CameraModel MakeCameraModel(const CameraCalibration& calibration, int width, int height) {
   CameraModel camera;
   camera.R_rect_00 = calibration.R_rect_00;
   camera.P_rect_02 = calibration.P_rect_02;

@@ -4,42 +4,13 @@
 #include <vector>
 
 #include "core/io/kitti_calib.h"
+#include "core/types/camera_model.h"
 #include "core/types/transform.h"
 
 namespace stcalib {
 
-// The rectified colour camera image_02 (method.md §1): a point p_camera in unrectified camera 0
-// projects as u ~ P_rect_02 · [R_rect_00 · p_camera; 1].
-struct CameraModel {
-  Eigen::Matrix3d R_rect_00 = Eigen::Matrix3d::Identity();
-  Eigen::Matrix<double, 3, 4> P_rect_02 = Eigen::Matrix<double, 3, 4>::Zero();
-  int width = 0;             ///< [px], read from the image or S_rect_02, never assumed
-  int height = 0;            ///< [px]
-  double min_depth_m = 0.5;  ///< points nearer than this (rectified z) are not projected [m]
-
-  static CameraModel FromCalibration(const CameraCalibration& calibration, int width, int height);
-
-  // Projects a point of the unrectified camera-0 frame. Templated so that Ceres Jets pass.
-  // Returns false when the point is not in front of the camera (rectified z < min_depth_m).
-  template <typename T>
-  bool Project(const Eigen::Matrix<T, 3, 1>& p_camera, Eigen::Matrix<T, 2, 1>* pixel,
-               T* depth_m) const {
-    const Eigen::Matrix<T, 3, 1> p_rect = R_rect_00.cast<T>() * p_camera;
-    if (p_rect.z() < T(min_depth_m)) return false;
-    const Eigen::Matrix<T, 3, 1> h =
-        P_rect_02.leftCols<3>().cast<T>() * p_rect + P_rect_02.col(3).cast<T>();
-    if (h.z() <= T(0)) return false;
-    (*pixel)(0) = h.x() / h.z();
-    (*pixel)(1) = h.y() / h.z();
-    *depth_m = p_rect.z();
-    return true;
-  }
-
-  bool InImage(const Eigen::Vector2d& pixel) const {
-    return pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() <= width - 1.0 &&
-           pixel.y() <= height - 1.0;
-  }
-};
+// CameraModel from calib_cam_to_cam.txt with the image size read from the image.
+CameraModel MakeCameraModel(const CameraCalibration& calibration, int width, int height);
 
 struct ProjectedPoint {
   Eigen::Vector2d pixel;  ///< [px]
