@@ -4,7 +4,6 @@
 #include <random>
 #include <vector>
 
-#include <ceres/gradient_checker.h>
 #include <ceres/manifold.h>
 #include <ceres/product_manifold.h>
 #include <gtest/gtest.h>
@@ -61,6 +60,10 @@ TEST(MotionModel, GroupPropertyAndLogRoundTrip) {
 // Tangent-space Jacobian check: the analytic (autodiff) Jacobian times the manifold's
 // PlusJacobian against central differences of f(Plus(x, ±h·e_k)) — exactly the derivative the
 // solver uses. Returns the worst relative error over all tangent directions.
+// (ceres::GradientChecker is not used: it first requires the residuals evaluated with and
+// without Jacobians to be bit-identical, and Eigen's quaternion products round the last bit
+// differently for double and for Jet — a 1e-15 difference that makes it reject both functors
+// and print meaningless numeric Jacobians.)
 double WorstTangentJacobianError(const ceres::CostFunction& cost, double* pose, double* delta) {
   const ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> manifold;
   const int n = cost.num_residuals();
@@ -204,11 +207,6 @@ TEST(CalibrationPriorCost, NominalValuesAndJacobians) {
   const double expected[7] = {0, 0, 2 * std::sin(0.01) / sigma_r, 1, 0, 0, 1.5};
   for (int k = 0; k < 7; ++k) EXPECT_NEAR(r[k], expected[k], 1e-9) << k;
 
-  ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> pose_manifold;
-  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr};
-  ceres::GradientChecker checker(cost.get(), &manifolds, ceres::NumericDiffOptions());
-  ceres::GradientChecker::ProbeResults results;
-  EXPECT_TRUE(checker.Probe(params, 1e-6, &results)) << results.error_log;
   EXPECT_LT(WorstTangentJacobianError(*cost, pose, &delta), 1e-6);
 }
 
