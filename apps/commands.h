@@ -16,6 +16,8 @@ int RunInfo();
 int RunProject();
 int RunSimulate();
 int RunFeatures();
+int RunCalibrate();
+int RunDemo();
 
 // Prints "stcalib <command>: error: <message>" to stderr and returns kExitFailure.
 int ReportError(const std::string& command, const Status& status);

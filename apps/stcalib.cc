@@ -35,6 +35,17 @@ const std::vector<Subcommand>& Subcommands() {
       {"features", "--drive=DRIVE_DIR --frame=I --out=DIR [--calib_dir=DIR]",
        "image edge mask and IDT, LiDAR edge points (vertical, horizontal, dynamic) as PNGs",
        &RunFeatures},
+      {"calibrate",
+       "--drive=DRIVE_DIR [--calib_dir=DIR] [--init_calib=FILE] [--perturb_rot_deg=D] "
+       "[--perturb_trans_m=M] [--perturb_time_s=S] [--seed=S] [--first_frame=I] [--num_frames=N] "
+       "[--out=DIR] [--flagfile=configs/X.flags]",
+       "online calibration of rotation, translation and time offset; writes the estimate, "
+       "result.json, per_frame.csv and pictures; exit 0 only when converged",
+       &RunCalibrate},
+      {"demo", "[--out=DIR] [--seed=S]",
+       "simulate a drive (true time offset +30 ms), calibrate it from +-2 deg / +-5 cm, print "
+       "truth, start, estimate and error",
+       &RunDemo},
   };
   return kSubcommands;
 }

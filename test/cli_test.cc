@@ -6,6 +6,8 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "core/io/image.h"
@@ -137,6 +139,24 @@ TEST(Cli, FeaturesOnDegenerateFramesWarnsButDoesNotCrash) {
       RunStcalib("features --drive=" + drive + " --frame=2 --out=" + tmp.path() + "/g");
   EXPECT_EQ(empty.exit_code, 0) << empty.output;
   EXPECT_THAT(empty.output, HasSubstr("empty sweep"));
+}
+
+TEST(Cli, CalibrateWithoutFeaturesFailsAndClaimsNothing) {
+  testing::ScopedTempDir tmp;
+  const std::string drive = testing::MakeTinyDrive(tmp.path(), 4);
+  const std::string out = tmp.path() + "/cal";
+  const RunResult r = RunStcalib("calibrate --drive=" + drive + " --out=" + out);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("not converged"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/calib_velo_to_cam.txt"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/time_offset.txt"));
+  std::ifstream result(out + "/result.json");
+  std::stringstream text;
+  text << result.rdbuf();
+  EXPECT_THAT(text.str(), HasSubstr("\"converged\": false"));
+  EXPECT_EQ(RunStcalib("calibrate --drive=" + drive + " --out=" + out + " --loss=l3").exit_code, 2);
+  EXPECT_EQ(RunStcalib("calibrate --drive=" + drive).exit_code, 2);  // no --out
+  EXPECT_EQ(RunStcalib("calibrate --drive=" + drive + " --out=" + out + " --num_frames=50").exit_code, 1);
 }
 
 TEST(Cli, SimulateRejectsBadFlags) {

@@ -197,12 +197,33 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
   features.idt = InverseDistanceTransform(distance, options.basin_px, options.smoothing_sigma_px);
   features.idt_suppressed = SuppressTexture(features.idt, options.suppression_sigma_px);
   for (double basin : options.pyramid_basins_px) {
-    features.idt_pyramid.push_back(SuppressTexture(
-        InverseDistanceTransform(distance, basin, std::max(options.smoothing_sigma_px, basin / 10)),
-        std::max(options.suppression_sigma_px, basin)));
+    cv::Mat level =
+        InverseDistanceTransform(distance, basin, std::max(options.smoothing_sigma_px, basin / 10));
+    if (options.suppress_pyramid) {
+      level = SuppressTexture(level, std::max(options.suppression_sigma_px, 2 * basin));
+    }
+    features.idt_pyramid.push_back(level);
   }
   cv::min(distance, options.basin_px, features.distance_px);
   Smooth(&features.distance_px, options.smoothing_sigma_px);
+  if (options.split_orientation) {
+    const cv::Mat* raw[2] = {&features.distance_vertical_raw_px, &features.distance_horizontal_raw_px};
+    for (int o = 0; o < 2; ++o) {
+      OrientedMaps& m = features.oriented[o];
+      m.idt = InverseDistanceTransform(*raw[o], options.basin_px, options.smoothing_sigma_px);
+      m.idt_suppressed = SuppressTexture(m.idt, options.suppression_sigma_px);
+      cv::min(*raw[o], options.basin_px, m.distance_px);
+      Smooth(&m.distance_px, options.smoothing_sigma_px);
+      for (double basin : options.pyramid_basins_px) {
+        cv::Mat level =
+            InverseDistanceTransform(*raw[o], basin, std::max(options.smoothing_sigma_px, basin / 10));
+        if (options.suppress_pyramid) {
+          level = SuppressTexture(level, std::max(options.suppression_sigma_px, 2 * basin));
+        }
+        m.pyramid.push_back(level);
+      }
+    }
+  }
   return features;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,8 @@ struct ImageFeatureOptions {
   double basin_px = 20;               ///< D_max of the IDT [px]
   double smoothing_sigma_px = 1.5;    ///< Gaussian σ applied to the IDT and distance maps [px]
   double suppression_sigma_px = 12;   ///< wide blur subtracted for the texture-suppressed map [px]
-  std::vector<double> pyramid_basins_px;  ///< extra texture-suppressed IDTs, e.g. {60, 30}
+  std::vector<double> pyramid_basins_px;  ///< extra IDTs with wider basins, e.g. {60, 30}
+  bool suppress_pyramid = true;           ///< texture-suppress the pyramid IDTs
   // Texture suppression on the edge mask: edge pixels whose (2·density_window_px+1)² window is
   // denser than this share of edge pixels are dropped (foliage, gravel); 0 = keep all.
   double max_edge_density = 0.0;
@@ -43,6 +45,14 @@ struct ImageFeatureOptions {
   Status Validate() const;
 };
 
+// The maps of one edge orientation (near-vertical or near-horizontal image edges).
+struct OrientedMaps {
+  cv::Mat idt;                  ///< CV_32F, smoothed IDT in [0, 255]
+  cv::Mat idt_suppressed;       ///< texture-suppressed IDT
+  cv::Mat distance_px;          ///< smoothed min(D, basin) [px]
+  std::vector<cv::Mat> pyramid;  ///< IDTs at pyramid_basins_px (suppressed if asked)
+};
+
 struct ImageFeatures {
   cv::Mat edge_mask;        ///< CV_8U, 255 on edge pixels
   cv::Mat distance_raw_px;  ///< CV_32F, distance to the nearest edge pixel [px], unsmoothed
@@ -51,8 +61,10 @@ struct ImageFeatures {
   cv::Mat distance_horizontal_raw_px;  ///< to near-horizontal edge pixels [px] (split_orientation)
   cv::Mat idt;                         ///< CV_32F, smoothed IDT in [0, 255]
   cv::Mat idt_suppressed;  ///< CV_32F, max(0, IDT − wide blur of IDT): dense texture fades
-  std::vector<cv::Mat> idt_pyramid;  ///< texture-suppressed IDTs at pyramid_basins_px
+  std::vector<cv::Mat> idt_pyramid;  ///< IDTs at pyramid_basins_px (suppressed if asked)
   std::vector<cv::Vec4f> segments;   ///< line segments at full-size coordinates (LSD/FLD)
+  // With split_orientation: the maps of near-vertical [0] and near-horizontal [1] edges.
+  std::array<OrientedMaps, 2> oriented;
   int edge_pixels = 0;               ///< after texture suppression
   int dense_pixels_removed = 0;
 

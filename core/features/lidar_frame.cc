@@ -69,79 +69,91 @@ LidarFrameFeatures ComputeLidarFrameFeatures(LidarScan scan, double stamp_s,
   return f;
 }
 
-namespace {
+SweepCache::SweepCache(const Drive& drive, const DriveMotion& motion,
+                       const LidarFeatureOptions& options, size_t capacity)
+    : drive_(drive),
+      motion_(motion),
+      options_(options),
+      sweep_s_(SweepDurationSeconds(drive)),
+      capacity_(std::max<size_t>(capacity, 4)) {}
 
-// Base features of drive frames, computed once each.
-class BaseCache {
- public:
-  BaseCache(const Drive& drive, const DriveMotion& motion, const LidarFeatureOptions& options)
-      : drive_(drive), motion_(motion), options_(options), sweep_s_(SweepDurationSeconds(drive)) {}
-
-  Status Get(size_t frame, const LidarFrameFeatures** features) {
-    auto it = cache_.find(frame);
-    if (it == cache_.end()) {
-      LidarScan scan;
-      STCALIB_RETURN_IF_ERROR(drive_.LoadScan(frame, &scan));
-      if (scan.size() == 0) LOG(WARNING) << drive_.VelodynePath(frame) << ": empty sweep";
-      const double stamp = motion_.Seconds(drive_.lidar_stamps_ns[frame]);
-      it = cache_
-               .emplace(frame, ComputeLidarSweepBase(std::move(scan), stamp, sweep_s_,
-                                                     motion_.PoseFunction(), options_))
-               .first;
-    }
-    *features = &it->second;
-    return Status::Ok();
+void SweepCache::Evict(size_t newest) {
+  while (base_.size() > capacity_ && base_.begin()->first + capacity_ <= newest) {
+    base_.erase(base_.begin());
   }
-
-  // References of `frame`: the previous sweep, and the one long_baseline_s back.
-  Status References(size_t frame, std::vector<ReferenceFeatures>* references) {
-    references->clear();
-    if (!options_.remove_dynamic || frame == 0) return Status::Ok();
-    const double period =
-        drive_.NumFrames() > 1
-            ? NsToSeconds(drive_.lidar_stamps_ns.back() - drive_.lidar_stamps_ns.front()) /
-                  (drive_.NumFrames() - 1)
-            : 0.1;
-    const size_t back =
-        std::max<size_t>(1, static_cast<size_t>(std::lround(options_.dynamic.long_baseline_s /
-                                                            std::max(period, 1e-3))));
-    const LidarFrameFeatures* current;
-    STCALIB_RETURN_IF_ERROR(Get(frame, &current));
-    for (size_t gap : {size_t{1}, back}) {
-      if (gap > frame || (gap == back && back == 1 && !references->empty())) continue;
-      const LidarFrameFeatures* reference;
-      STCALIB_RETURN_IF_ERROR(Get(frame - gap, &reference));
-      ReferenceFeatures r;
-      r.features = reference;
-      r.T_current_reference =
-          RelativeLidarPose(motion_.PoseFunction(), current->stamp_s, reference->stamp_s);
-      r.check_visibility = gap > 1;
-      references->push_back(r);
-    }
-    return Status::Ok();
+  while (finished_.size() > capacity_ && finished_.begin()->first + capacity_ <= newest) {
+    finished_.erase(finished_.begin());
   }
+}
 
- private:
-  const Drive& drive_;
-  const DriveMotion& motion_;
-  const LidarFeatureOptions& options_;
-  double sweep_s_;
-  std::map<size_t, LidarFrameFeatures> cache_;
-};
+Status SweepCache::Base(size_t frame, const LidarFrameFeatures** features) {
+  auto it = base_.find(frame);
+  if (it == base_.end()) {
+    STCALIB_RETURN_IF_ERROR(drive_.CheckFrame(frame));
+    LidarScan scan;
+    STCALIB_RETURN_IF_ERROR(drive_.LoadScan(frame, &scan));
+    if (scan.size() == 0) LOG(WARNING) << drive_.VelodynePath(frame) << ": empty sweep";
+    const double stamp = motion_.Seconds(drive_.lidar_stamps_ns[frame]);
+    it = base_
+             .emplace(frame, ComputeLidarSweepBase(std::move(scan), stamp, sweep_s_,
+                                                   motion_.PoseFunction(), options_))
+             .first;
+    Evict(frame);
+  }
+  *features = &it->second;
+  return Status::Ok();
+}
 
-}  // namespace
+Status SweepCache::References(size_t frame, std::vector<ReferenceFeatures>* references) {
+  references->clear();
+  if (!options_.remove_dynamic || frame == 0) return Status::Ok();
+  const double period =
+      drive_.NumFrames() > 1
+          ? NsToSeconds(drive_.lidar_stamps_ns.back() - drive_.lidar_stamps_ns.front()) /
+                (drive_.NumFrames() - 1)
+          : 0.1;
+  const size_t back = std::max<size_t>(
+      1, static_cast<size_t>(std::lround(options_.dynamic.long_baseline_s / std::max(period, 1e-3))));
+  const LidarFrameFeatures* current;
+  STCALIB_RETURN_IF_ERROR(Base(frame, &current));
+  for (size_t gap : {size_t{1}, back}) {
+    if (gap > frame || (gap == back && back == 1 && !references->empty())) continue;
+    const LidarFrameFeatures* reference;
+    STCALIB_RETURN_IF_ERROR(Base(frame - gap, &reference));
+    ReferenceFeatures r;
+    r.features = reference;
+    r.T_current_reference =
+        RelativeLidarPose(motion_.PoseFunction(), current->stamp_s, reference->stamp_s);
+    r.check_visibility = gap > 1;
+    references->push_back(r);
+  }
+  return Status::Ok();
+}
+
+Status SweepCache::Finished(size_t frame, const LidarFrameFeatures** features) {
+  auto it = finished_.find(frame);
+  if (it == finished_.end()) {
+    std::vector<ReferenceFeatures> references;
+    STCALIB_RETURN_IF_ERROR(References(frame, &references));
+    const LidarFrameFeatures* base;
+    STCALIB_RETURN_IF_ERROR(Base(frame, &base));
+    LidarFrameFeatures f = *base;
+    FinishLidarFrameFeatures(references, options_, &f);
+    it = finished_.emplace(frame, std::move(f)).first;
+    Evict(frame);
+  }
+  *features = &it->second;
+  return Status::Ok();
+}
 
 Status LoadLidarFrameFeatures(const Drive& drive, const DriveMotion& motion, size_t frame,
                               const LidarFeatureOptions& options, LidarFrameFeatures* features) {
   STCALIB_RETURN_IF_ERROR(options.Validate());
   STCALIB_RETURN_IF_ERROR(drive.CheckFrame(frame));
-  BaseCache cache(drive, motion, options);
-  std::vector<ReferenceFeatures> references;
-  STCALIB_RETURN_IF_ERROR(cache.References(frame, &references));
-  const LidarFrameFeatures* base;
-  STCALIB_RETURN_IF_ERROR(cache.Get(frame, &base));
-  *features = *base;
-  FinishLidarFrameFeatures(references, options, features);
+  SweepCache cache(drive, motion, options);
+  const LidarFrameFeatures* finished;
+  STCALIB_RETURN_IF_ERROR(cache.Finished(frame, &finished));
+  *features = *finished;
   return Status::Ok();
 }
 
@@ -163,29 +175,31 @@ Status BuildLocalMap(const Drive& drive, const DriveMotion& motion, size_t frame
                      const LidarFeatureOptions& options, const LocalMapOptions& map_options,
                      LidarEdges* map, LocalMapStats* stats) {
   STCALIB_RETURN_IF_ERROR(options.Validate());
-  STCALIB_RETURN_IF_ERROR(drive.CheckFrame(frame));
+  SweepCache cache(drive, motion, options);
+  return cache.LocalMap(frame, map_options, map, stats);
+}
+
+Status SweepCache::LocalMap(size_t frame, const LocalMapOptions& map_options, LidarEdges* map,
+                            LocalMapStats* stats) {
+  STCALIB_RETURN_IF_ERROR(drive_.CheckFrame(frame));
   if (map_options.sweeps < 1) return Status::Error("local map: sweeps must be >= 1");
   *stats = LocalMapStats();
   const size_t first =
       frame + 1 >= static_cast<size_t>(map_options.sweeps) ? frame + 1 - map_options.sweeps : 0;
-  BaseCache cache(drive, motion, options);
-  std::vector<LidarFrameFeatures> sweeps;
+  std::vector<const LidarFrameFeatures*> sweeps;
   for (size_t k = first; k <= frame; ++k) {
-    std::vector<ReferenceFeatures> references;
-    STCALIB_RETURN_IF_ERROR(cache.References(k, &references));
-    const LidarFrameFeatures* base;
-    STCALIB_RETURN_IF_ERROR(cache.Get(k, &base));
-    sweeps.push_back(*base);
-    FinishLidarFrameFeatures(references, options, &sweeps.back());
+    const LidarFrameFeatures* f;
+    STCALIB_RETURN_IF_ERROR(Finished(k, &f));
+    sweeps.push_back(f);
   }
-  const LidarFrameFeatures& current = sweeps.back();
+  const LidarFrameFeatures& current = *sweeps.back();
   std::vector<std::pair<const LidarEdges*, Rigid3d>> previous;
   for (size_t k = 0; k + 1 < sweeps.size(); ++k) {
-    Rigid3d T = RelativeLidarPose(motion.PoseFunction(), current.stamp_s, sweeps[k].stamp_s);
+    Rigid3d T = RelativeLidarPose(motion_.PoseFunction(), current.stamp_s, sweeps[k]->stamp_s);
     if (map_options.use_ndt) {
       std::vector<Eigen::Vector3d> source, target;
-      for (size_t i = 0; i < sweeps[k].deskewed.size(); ++i) {
-        if (!sweeps[k].ground[i]) source.push_back(sweeps[k].deskewed[i]);
+      for (size_t i = 0; i < sweeps[k]->deskewed.size(); ++i) {
+        if (!sweeps[k]->ground[i]) source.push_back(sweeps[k]->deskewed[i]);
       }
       for (size_t i = 0; i < current.deskewed.size(); ++i) {
         if (!current.ground[i]) target.push_back(current.deskewed[i]);
@@ -197,7 +211,7 @@ Status BuildLocalMap(const Drive& drive, const DriveMotion& motion, size_t frame
           (result.T_target_source.translation() - T.translation()).norm());
       T = result.T_target_source;
     }
-    previous.emplace_back(&sweeps[k].edges, T);
+    previous.emplace_back(&sweeps[k]->edges, T);
   }
   *map = MergeEdges(current.edges, previous);
   stats->sweeps_used = static_cast<int>(sweeps.size());

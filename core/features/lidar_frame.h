@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <vector>
 
 #include "core/features/dynamic_filter.h"
@@ -58,13 +59,8 @@ LidarFrameFeatures ComputeLidarFrameFeatures(LidarScan scan, double stamp_s,
                                              const std::vector<ReferenceFeatures>& references,
                                              const LidarFeatureOptions& options);
 
-// Loads frame `frame` of a drive and computes its features; the dynamic filter compares with
-// the previous sweep and with the sweep DynamicFilterOptions::long_baseline_s earlier.
-Status LoadLidarFrameFeatures(const Drive& drive, const DriveMotion& motion, size_t frame,
-                              const LidarFeatureOptions& options, LidarFrameFeatures* features);
-
 // Local map (method.md §4): the edges of `sweeps` consecutive sweeps ending at `frame`, merged
-// into the frame of the last one, with oxts poses or, when `ndt` is set, poses refined by NDT.
+// into the frame of the last one, with oxts poses or, when `use_ndt` is set, refined by NDT.
 struct LocalMapOptions {
   int sweeps = 3;
   bool use_ndt = false;
@@ -75,6 +71,34 @@ struct LocalMapStats {
   std::vector<int> ndt_iterations;
   std::vector<double> ndt_correction_m;  ///< |t| of NDT's change to the oxts pose [m]
 };
+// Loads frame `frame` of a drive and computes its features; the dynamic filter compares with
+// the previous sweep and with the sweep DynamicFilterOptions::long_baseline_s earlier.
+Status LoadLidarFrameFeatures(const Drive& drive, const DriveMotion& motion, size_t frame,
+                              const LidarFeatureOptions& options, LidarFrameFeatures* features);
+
+// Sweeps of a drive computed once each and kept while they are among the last `capacity`
+// frames asked for: a sequential pass computes every sweep's base and finished features once.
+class SweepCache {
+ public:
+  SweepCache(const Drive& drive, const DriveMotion& motion, const LidarFeatureOptions& options,
+             size_t capacity = 8);
+  Status Base(size_t frame, const LidarFrameFeatures** features);      ///< no dynamic filter
+  Status Finished(size_t frame, const LidarFrameFeatures** features);  ///< with it, and edges
+  // The previous sweep and the one DynamicFilterOptions::long_baseline_s back.
+  Status References(size_t frame, std::vector<ReferenceFeatures>* references);
+  Status LocalMap(size_t frame, const LocalMapOptions& map_options, LidarEdges* map,
+                  LocalMapStats* stats);
+
+ private:
+  void Evict(size_t newest);
+  const Drive& drive_;
+  const DriveMotion& motion_;
+  const LidarFeatureOptions options_;
+  double sweep_s_;
+  size_t capacity_;
+  std::map<size_t, LidarFrameFeatures> base_, finished_;
+};
+
 Status BuildLocalMap(const Drive& drive, const DriveMotion& motion, size_t frame,
                      const LidarFeatureOptions& options, const LocalMapOptions& map_options,
                      LidarEdges* map, LocalMapStats* stats);

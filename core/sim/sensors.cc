@@ -126,23 +126,65 @@ cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, c
 
   const Eigen::Vector3d sky_top(0.85, 0.62, 0.42), sky_horizon(0.95, 0.88, 0.82);  // BGR
   constexpr double kAmbient = 0.35, kDiffuse = 0.65;
-  std::normal_distribution<double> noise(0.0, rig.noise_sigma);
-  cv::Mat image(rig.height, rig.width, CV_8UC3);
-  for (int v = 0; v < rig.height; ++v) {
-    auto* row = image.ptr<cv::Vec3b>(v);
-    for (int u = 0; u < rig.width; ++u) {
-      const Eigen::Vector3d dir = (R_world_rect * (K_inv * Eigen::Vector3d(u, v, 1))).normalized();
-      Eigen::Vector3d colour;
-      RayHit hit;
-      if (scene.Intersect(index, origin, dir, t_s, kMaxRange, &hit)) {
-        const Material& m = scene.materials()[hit.material];
-        const double shade =
-            kAmbient + kDiffuse * std::max(0.0, hit.normal_world.dot(rig.sun_world));
-        colour = m.albedo_bgr * (shade * TextureGain(m, hit.point_world));
-      } else {
-        const double k = std::clamp(dir.z() * 3.0, 0.0, 1.0);
-        colour = (1 - k) * sky_horizon + k * sky_top;
+  // Radiance along the ray through (u, v); `surface` receives what it hit (−2 sky, −1 ground,
+  // else the object) and its material.
+  auto shade = [&](double u, double v, int* surface, int* material) {
+    const Eigen::Vector3d dir = (R_world_rect * (K_inv * Eigen::Vector3d(u, v, 1))).normalized();
+    RayHit hit;
+    if (scene.Intersect(index, origin, dir, t_s, kMaxRange, &hit)) {
+      const Material& m = scene.materials()[hit.material];
+      const double light = kAmbient + kDiffuse * std::max(0.0, hit.normal_world.dot(rig.sun_world));
+      *surface = hit.object;
+      *material = hit.material;
+      return Eigen::Vector3d(m.albedo_bgr * (light * TextureGain(m, hit.point_world)));
+    }
+    *surface = -2;
+    *material = -1;
+    const double k = std::clamp(dir.z() * 3.0, 0.0, 1.0);
+    return Eigen::Vector3d((1 - k) * sky_horizon + k * sky_top);
+  };
+  // First pass: one ray through each pixel centre.
+  const int w = rig.width, h = rig.height;
+  std::vector<Eigen::Vector3d> radiance(static_cast<size_t>(w) * h);
+  std::vector<int> surface(radiance.size()), material(radiance.size());
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t i = static_cast<size_t>(v) * w + u;
+      radiance[i] = shade(u, v, &surface[i], &material[i]);
+    }
+  }
+  // Second pass: a pixel whose neighbours see another surface or material straddles an edge; it
+  // integrates over its area (3×3 samples), as a real pixel does. Without this, a step edge gives
+  // two equal gradient maxima and edge detectors pick one side: a half-pixel bias.
+  constexpr int kSub = 3;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t i = static_cast<size_t>(v) * w + u;
+      bool edge = false;
+      for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+        const int uu = u + du, vv = v + dv;
+        if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
+        const size_t j = static_cast<size_t>(vv) * w + uu;
+        edge = edge || surface[j] != surface[i] || material[j] != material[i];
       }
+      if (!edge) continue;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int unused_surface, unused_material;
+      for (int a = 0; a < kSub; ++a) {
+        for (int b = 0; b < kSub; ++b) {
+          sum += shade(u + (a + 0.5) / kSub - 0.5, v + (b + 0.5) / kSub - 0.5, &unused_surface,
+                       &unused_material);
+        }
+      }
+      radiance[i] = sum / (kSub * kSub);
+    }
+  }
+  std::normal_distribution<double> noise(0.0, rig.noise_sigma);
+  cv::Mat image(h, w, CV_8UC3);
+  for (int v = 0; v < h; ++v) {
+    auto* row = image.ptr<cv::Vec3b>(v);
+    for (int u = 0; u < w; ++u) {
+      const Eigen::Vector3d& colour = radiance[static_cast<size_t>(v) * w + u];
       for (int c = 0; c < 3; ++c) {
         row[u][c] = cv::saturate_cast<uint8_t>(255.0 * colour[c] + noise(*rng));
       }

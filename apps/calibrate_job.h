@@ -1,0 +1,42 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/online/frame_source.h"
+#include "core/online/online_calibrator.h"
+#include "core/types/calibration.h"
+
+namespace stcalib::cli {
+
+// One run of `stcalib calibrate` (also what `stcalib demo` runs).
+struct CalibrateJob {
+  std::string drive_dir, calib_dir, init_calib, out_dir;
+  double perturb_rot_deg = 0, perturb_trans_m = 0, perturb_time_s = 0;
+  uint64_t seed = 1;
+  int first_frame = 0, num_frames = 0;
+  int disturb_frame = -1;
+  double disturb_rot_deg = 2.0;
+  OnlineCalibratorOptions online;
+  FrameSourceOptions source;
+  bool progress = true;
+};
+
+struct CalibrateOutcome {
+  bool converged = false;
+  bool alias_suspect = false;
+  std::string reason;
+  bool has_truth = false;
+  std::string reference;  ///< "ground truth (simulated)" or "drive calibration"
+  CalibrationState reference_state, initial, estimate;
+  CalibrationError error, initial_error;
+  std::vector<FrameReport> reports;
+  std::vector<std::string> pictures;
+  double mean_frame_ms = 0;
+};
+
+CalibrateJob CalibrateJobFromFlags();
+// Runs the job and writes its outputs; returns the exit code (0 only when converged).
+int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome);
+
+}  // namespace stcalib::cli

@@ -1,0 +1,389 @@
+// stcalib calibrate: online calibration of a drive (method.md §9).
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "apps/calibrate_job.h"
+#include "apps/commands.h"
+#include "apps/flags.h"
+#include "apps/plot.h"
+#include "core/io/image.h"
+#include "core/io/text.h"
+#include "core/search/adaptive_grid_search.h"
+
+namespace stcalib::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+Status ReadGroundTruth(const std::string& path, CalibrationState* truth) {
+  std::vector<std::string> lines;
+  STCALIB_RETURN_IF_ERROR(ReadLines(path, &lines));
+  std::string text;
+  for (const auto& l : lines) text += l + "\n";
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    const auto& m = j.at("T_camera_lidar");
+    if (m.size() != 16) return Status::Error(path + ": T_camera_lidar must have 16 numbers");
+    Eigen::Matrix4d T;
+    for (int k = 0; k < 16; ++k) T(k / 4, k % 4) = m.at(k).get<double>();
+    truth->T_camera_lidar.matrix() = T;
+    truth->time_offset_s = j.at("time_offset_s").get<double>();
+  } catch (const std::exception& e) {
+    return Status::Error(path + ": " + e.what());
+  }
+  return Status::Ok();
+}
+
+nlohmann::json MatrixJson(const Rigid3d& T) {
+  nlohmann::json values = nlohmann::json::array();
+  for (int k = 0; k < 16; ++k) values.push_back(T.matrix()(k / 4, k % 4));
+  return values;
+}
+
+nlohmann::json ErrorJson(const CalibrationError& e) {
+  return {{"rotation_deg", e.rotation_deg},   {"roll_deg", e.roll_deg},
+          {"pitch_deg", e.pitch_deg},         {"yaw_deg", e.yaw_deg},
+          {"translation_m", e.translation_norm_m}, {"x_m", e.translation_m.x()},
+          {"y_m", e.translation_m.y()},       {"z_m", e.translation_m.z()},
+          {"time_offset_s", e.time_offset_s}};
+}
+
+// Roll, pitch, yaw [deg] of R = Rz(yaw)·Ry(pitch)·Rx(roll).
+Eigen::Vector3d EulerRpyDeg(const Eigen::Matrix3d& R) {
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  const double roll = std::atan2(R(2, 1), R(2, 2));
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  return Eigen::Vector3d(roll, pitch, yaw) * 180.0 / M_PI;
+}
+
+cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
+                        const CalibrationState& state, const std::string& title) {
+  cv::Mat canvas;
+  image.convertTo(canvas, CV_8UC3, 0.55);
+  const double e = frame.e0_s + state.time_offset_s;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const Eigen::Vector3d p =
+        state.T_camera_lidar * ApplyLidarMotion<double>(frame.twist, e, frame.points_lidar[i]);
+    Eigen::Vector2d pixel;
+    double depth;
+    if (!frame.camera.Project<double>(p, &pixel, &depth) || !frame.camera.InImage(pixel)) continue;
+    const int u = static_cast<int>(std::lround(pixel.x())), v = static_cast<int>(std::lround(pixel.y()));
+    const bool near = frame.image.distance_raw_px.at<float>(v, u) <= 2.0f;
+    cv::circle(canvas, cv::Point(u, v), 2, near ? cv::Scalar(60, 255, 60) : cv::Scalar(40, 40, 255),
+               cv::FILLED);
+  }
+  cv::putText(canvas, title, cv::Point(10, 22), cv::FONT_HERSHEY_SIMPLEX, 0.6,
+              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  return canvas;
+}
+
+std::string Csv(const std::string& s) { return "\"" + s + "\""; }
+
+}  // namespace
+
+CalibrateJob CalibrateJobFromFlags() {
+  CalibrateJob job;
+  job.drive_dir = FLAGS_drive;
+  job.calib_dir = FLAGS_calib_dir;
+  job.init_calib = FLAGS_init_calib;
+  job.out_dir = FLAGS_out;
+  job.perturb_rot_deg = FLAGS_perturb_rot_deg;
+  job.perturb_trans_m = FLAGS_perturb_trans_m;
+  job.perturb_time_s = FLAGS_perturb_time_s;
+  job.seed = FLAGS_seed;
+  job.first_frame = FLAGS_first_frame;
+  job.num_frames = FLAGS_num_frames;
+  job.disturb_frame = FLAGS_disturb_frame;
+  job.disturb_rot_deg = FLAGS_disturb_rot_deg;
+  OnlineCalibratorOptions& o = job.online;
+  o.window_frames = FLAGS_window_frames;
+  o.time_offset_bound_s = FLAGS_time_offset_bound_s;
+  o.lost_health = FLAGS_lost_health;
+  o.score.horizontal_weight = FLAGS_horizontal_weight;
+  o.search.alpha1_rotation_deg = FLAGS_alpha1_rotation_deg;
+  o.search.alpha2_translation_m = FLAGS_alpha2_translation_m;
+  o.search.alpha3_rotation_deg = FLAGS_alpha3_rotation_deg;
+  o.search.alpha4_translation_m = FLAGS_alpha4_translation_m;
+  o.search.gamma = FLAGS_gamma;
+  o.search.search_time_offset = FLAGS_estimate_time_offset;
+  o.refine.estimate_time_offset = FLAGS_estimate_time_offset;
+  o.refine.loss = FLAGS_loss == "huber" ? RefineOptions::Loss::kHuber : RefineOptions::Loss::kCauchy;
+  o.refine.loss_scale_px = FLAGS_loss_scale_px;
+  o.refine.horizontal_weight = FLAGS_horizontal_weight;
+  o.refine.prior_sigma_rotation_deg = FLAGS_prior_sigma_rotation_deg;
+  o.refine.prior_sigma_translation_m = FLAGS_prior_sigma_translation_m;
+  o.refine.observable_rotation_deg = FLAGS_observable_rotation_deg;
+  o.refine.observable_translation_m = FLAGS_observable_translation_m;
+  o.refine.observable_time_s = FLAGS_observable_time_s;
+  job.source.local_map.sweeps = FLAGS_local_map_sweeps;
+  job.source.local_map.use_ndt = FLAGS_use_ndt;
+  job.source.suppress_texture = FLAGS_suppress_texture;
+  job.source.oriented_maps = FLAGS_oriented_maps;
+  return job;
+}
+
+int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
+  const char* kCommand = "calibrate";
+  if (job.out_dir.empty()) return UsageError(kCommand, "--out=DIR is required");
+  Status status = job.online.Validate();
+  if (!status.ok()) return UsageError(kCommand, status.message());
+  Drive drive;
+  status = OpenDrive(job.drive_dir, job.calib_dir, &drive);
+  if (!status.ok()) return ReportError(kCommand, status);
+  const int first = job.first_frame;
+  const int last = job.num_frames > 0 ? first + job.num_frames - 1 : static_cast<int>(drive.NumFrames()) - 1;
+  if (first < 0 || first >= static_cast<int>(drive.NumFrames()) || last >= static_cast<int>(drive.NumFrames())) {
+    return ReportError(kCommand, Status::Error(drive.drive_dir + ": frames " + std::to_string(first) +
+                                               ".." + std::to_string(last) + " out of range (" +
+                                               std::to_string(drive.NumFrames()) + " frames)"));
+  }
+  std::unique_ptr<DriveFrameSource> source;
+  status = DriveFrameSource::Create(&drive, job.source, &source);
+  if (!status.ok()) return ReportError(kCommand, status);
+
+  // Reference: simulated ground truth when present, else the drive's own calibration.
+  const std::string truth_path = drive.calib_dir + "/ground_truth.json";
+  outcome->has_truth = fs::exists(truth_path);
+  if (outcome->has_truth) {
+    status = ReadGroundTruth(truth_path, &outcome->reference_state);
+    if (!status.ok()) return ReportError(kCommand, status);
+    outcome->reference = "ground truth (simulated)";
+  } else {
+    outcome->reference_state.T_camera_lidar = drive.T_camera_lidar;
+    outcome->reference = "drive calibration (" + drive.calib_dir + "/calib_velo_to_cam.txt)";
+  }
+  CalibrationState initial;
+  initial.T_camera_lidar = drive.T_camera_lidar;
+  if (!job.init_calib.empty()) {
+    status = ReadVeloToCam(job.init_calib, &initial.T_camera_lidar);
+    if (!status.ok()) return ReportError(kCommand, status);
+  }
+  std::mt19937_64 rng(job.seed);
+  auto sign = [&]() { return (rng() & 1) ? 1.0 : -1.0; };
+  const Eigen::Vector3d rpy(sign() * job.perturb_rot_deg, sign() * job.perturb_rot_deg,
+                            sign() * job.perturb_rot_deg);
+  const Eigen::Vector3d dt(sign() * job.perturb_trans_m, sign() * job.perturb_trans_m,
+                           sign() * job.perturb_trans_m);
+  initial.T_camera_lidar = PerturbTcameraLidar(initial.T_camera_lidar, rpy, dt);
+  initial.time_offset_s = job.perturb_time_s;
+  outcome->initial = initial;
+  outcome->initial_error = ComputeCalibrationError(initial, outcome->reference_state);
+
+  std::error_code ec;
+  fs::create_directories(job.out_dir, ec);
+  if (ec || !fs::is_directory(job.out_dir)) {
+    return ReportError(kCommand, Status::Error(job.out_dir + ": cannot create output folder"));
+  }
+
+  OnlineCalibrator calibrator(job.online, initial);
+  std::shared_ptr<const CalibrationFrame> first_frame, last_frame;
+  const auto run_start = std::chrono::steady_clock::now();
+  double frame_ms_sum = 0;
+  for (int i = first; i <= last; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto frame = std::make_shared<CalibrationFrame>();
+    status = source->Load(i, frame.get());
+    if (!status.ok()) return ReportError(kCommand, status);
+    if (i == job.disturb_frame) {
+      const Eigen::Vector3d d(sign() * job.disturb_rot_deg, sign() * job.disturb_rot_deg,
+                              sign() * job.disturb_rot_deg);
+      CalibrationState disturbed = calibrator.state();
+      disturbed.T_camera_lidar = PerturbTcameraLidar(disturbed.T_camera_lidar, d, Eigen::Vector3d::Zero());
+      calibrator.SetState(disturbed);
+    }
+    FrameReport report = calibrator.AddFrame(frame);
+    frame_ms_sum += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (!first_frame) first_frame = frame;
+    last_frame = frame;
+    outcome->reports.push_back(report);
+    if (getenv("STCALIB_DEBUG")) {
+      const CalibrationError es = ComputeCalibrationError(report.search.state, outcome->reference_state);
+      const CalibrationError er = ComputeCalibrationError(report.refine.state, outcome->reference_state);
+      std::fprintf(stderr, "\n[debug] frame %d search %.3f deg %.3f m %.1f ms | refine(%d) %.3f deg %.3f m %.1f ms | %s\n", i,
+                   es.rotation_deg, es.translation_norm_m, 1000 * es.time_offset_s, report.refine.usable,
+                   er.rotation_deg, er.translation_norm_m, 1000 * er.time_offset_s, report.reason.c_str());
+    }
+    if (job.progress) {
+      const CalibrationError e = ComputeCalibrationError(report.after, outcome->reference_state);
+      std::fprintf(stderr, "\rcalibrate: frame %d/%d  %s %.3f deg, %.3f m, dt %+.1f ms  gray %.2f  health %.2f   ",
+                   i - first + 1, last - first + 1, outcome->has_truth ? "error" : "vs drive calib",
+                   e.rotation_deg, e.translation_norm_m, 1000 * report.after.time_offset_s,
+                   report.gray_rate_after, report.health);
+    }
+  }
+  if (job.progress) std::fprintf(stderr, "\n");
+  outcome->mean_frame_ms = frame_ms_sum / outcome->reports.size();
+  outcome->estimate = calibrator.state();
+  outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
+
+  // Aliasing guard over δ on the final window.
+  WindowScorer scorer(calibrator.SearchWindow(), job.online.score);
+  const TimeOffsetProfile profile =
+      ProfileTimeOffset(&scorer, outcome->estimate, job.online.time_offset_bound_s, 0.0025);
+  outcome->alias_suspect = profile.alias_suspect;
+
+  // Convergence: the last frame's health is high and the estimate has settled.
+  const FrameReport& final_report = outcome->reports.back();
+  double settle_deg = 0;
+  for (size_t k = outcome->reports.size() >= 3 ? outcome->reports.size() - 3 : 0;
+       k < outcome->reports.size(); ++k) {
+    settle_deg = std::max(settle_deg, RotationErrorDeg(outcome->reports[k].after.T_camera_lidar.linear(),
+                                                       outcome->estimate.T_camera_lidar.linear()));
+  }
+  const int points = final_report.points;
+  if (points < 30) {
+    outcome->reason = "not converged: no usable features (" + std::to_string(points) +
+                      " LiDAR edge points in the image)";
+  } else if (final_report.health < 0.8) {
+    outcome->reason = "not converged: health " + std::to_string(final_report.health) +
+                      " < 0.8 (the estimate is not a clear optimum of the score)";
+  } else if (settle_deg > 0.3) {
+    outcome->reason = "not converged: still moving (" + std::to_string(settle_deg) +
+                      " deg over the last 3 frames)";
+  } else {
+    outcome->converged = true;
+    outcome->reason = "converged";
+  }
+  const RefineResult& refine = final_report.refine;
+
+  // Outputs.
+  const std::string out = job.out_dir;
+  auto fail = [&](const Status& s) { return ReportError(kCommand, s); };
+  if (outcome->converged) {
+    status = WriteVeloToCam(out + "/calib_velo_to_cam.txt", outcome->estimate.T_camera_lidar);
+    if (!status.ok()) return fail(status);
+    char line[64];
+    std::snprintf(line, sizeof(line), "%.9f\n", outcome->estimate.time_offset_s);
+    status = WriteTextFile(out + "/time_offset.txt", line);
+    if (!status.ok()) return fail(status);
+  } else {
+    // Never leave a file that claims success.
+    fs::remove(out + "/calib_velo_to_cam.txt", ec);
+    fs::remove(out + "/time_offset.txt", ec);
+  }
+  nlohmann::json std_json, observable_json;
+  for (int k = 0; k < kNumAxes; ++k) {
+    std_json[kAxisNames[k]] = refine.covariance_ok ? nlohmann::json(refine.std_dev[k]) : nlohmann::json(nullptr);
+    observable_json[kAxisNames[k]] = refine.observable[k];
+  }
+  const Eigen::Vector3d rpy_deg = EulerRpyDeg(outcome->estimate.T_camera_lidar.linear());
+  double search_ms = 0, refine_ms = 0;
+  for (const FrameReport& r : outcome->reports) {
+    search_ms += r.search_ms / outcome->reports.size();
+    refine_ms += r.refine_ms / outcome->reports.size();
+  }
+  nlohmann::json result = {
+      {"T_camera_lidar", MatrixJson(outcome->estimate.T_camera_lidar)},
+      {"time_offset_s", outcome->estimate.time_offset_s},
+      {"rpy_deg", {{"roll", rpy_deg.x()}, {"pitch", rpy_deg.y()}, {"yaw", rpy_deg.z()}}},
+      {"std", std_json},
+      {"observable", observable_json},
+      {"converged", outcome->converged},
+      {"reason", outcome->reason},
+      {"alias_suspect", outcome->alias_suspect},
+      {"alias_second_peak_s", profile.second_peak_s},
+      {"alias_second_peak_ratio", profile.second_peak_ratio},
+      {"time_forward_correlation", refine.time_forward_correlation},
+      {"score", final_report.score_after.score},
+      {"gray_rate", final_report.gray_rate_after},
+      {"health", final_report.health},
+      {"frames", {{"first", first}, {"last", last}}},
+      {"timing_ms",
+       {{"per_frame_mean", outcome->mean_frame_ms}, {"search_mean", search_ms},
+        {"refine_mean", refine_ms},
+        {"total", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run_start).count()}}},
+      {"reference", outcome->reference},
+      {"initial_error", ErrorJson(outcome->initial_error)},
+  };
+  if (outcome->has_truth) {
+    result["error"] = ErrorJson(outcome->error);
+  } else {
+    result["agreement_with_drive_calibration"] = ErrorJson(outcome->error);
+  }
+  status = WriteTextFile(out + "/result.json", result.dump(2) + "\n");
+  if (!status.ok()) return fail(status);
+
+  std::string csv =
+      "frame,accepted,coarse_search,points,gray_rate,health,roll_deg,pitch_deg,yaw_deg,x_m,y_m,z_m,"
+      "time_offset_s,rotation_error_deg,translation_error_m,time_offset_error_s,search_ms,refine_ms,"
+      "reason\n";
+  std::vector<double> xs, rot_err, trans_err_cm, dt_ms, roll_e, pitch_e, yaw_e;
+  for (const FrameReport& r : outcome->reports) {
+    const CalibrationError e = ComputeCalibrationError(r.after, outcome->reference_state);
+    const Eigen::Vector3d rpy = EulerRpyDeg(r.after.T_camera_lidar.linear());
+    char row[512];
+    std::snprintf(row, sizeof(row),
+                  "%d,%d,%d,%d,%.4f,%.4f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.6f,%.5f,%.5f,%.6f,%.2f,%.2f,",
+                  r.frame, r.accepted, r.coarse_search, r.points, r.gray_rate_after, r.health,
+                  rpy.x(), rpy.y(), rpy.z(), r.after.T_camera_lidar.translation().x(),
+                  r.after.T_camera_lidar.translation().y(), r.after.T_camera_lidar.translation().z(),
+                  r.after.time_offset_s, e.rotation_deg, e.translation_norm_m, e.time_offset_s,
+                  r.search_ms, r.refine_ms);
+    csv += row + Csv(r.reason) + "\n";
+    xs.push_back(r.frame);
+    rot_err.push_back(e.rotation_deg);
+    roll_e.push_back(e.roll_deg);
+    pitch_e.push_back(e.pitch_deg);
+    yaw_e.push_back(e.yaw_deg);
+    trans_err_cm.push_back(100 * e.translation_norm_m);
+    dt_ms.push_back(1000 * r.after.time_offset_s);
+  }
+  status = WriteTextFile(out + "/per_frame.csv", csv);
+  if (!status.ok()) return fail(status);
+
+  const std::string vs = outcome->has_truth ? "error vs ground truth" : "difference from the drive calibration";
+  std::vector<cv::Mat> panels = {
+      PlotPanel("rotation " + vs + " [deg]", xs,
+                {{"total", rot_err, cv::Scalar(0, 0, 0)}, {"roll", roll_e, cv::Scalar(0, 0, 220)},
+                 {"pitch", pitch_e, cv::Scalar(0, 160, 0)}, {"yaw", yaw_e, cv::Scalar(220, 0, 0)}}),
+      PlotPanel("translation " + vs + " [cm]", xs, {{"|t|", trans_err_cm, cv::Scalar(120, 0, 120)}}),
+      PlotPanel("time offset estimate [ms]" +
+                    (outcome->has_truth ? " (truth " + std::to_string(1000 * outcome->reference_state.time_offset_s).substr(0, 6) + ")"
+                                        : std::string()),
+                xs, {{"delta", dt_ms, cv::Scalar(0, 120, 200)}})};
+  cv::Mat convergence;
+  cv::vconcat(panels, convergence);
+  cv::Mat image;
+  status = drive.LoadImage(last_frame->index, &image);
+  if (!status.ok()) return fail(status);
+  for (const auto& [name, picture] : std::vector<std::pair<std::string, cv::Mat>>{
+           {"overlay_before.png", DrawEdgeOverlay(image, *last_frame, outcome->initial, "before: initial calibration")},
+           {"overlay_after.png", DrawEdgeOverlay(image, *last_frame, outcome->estimate, "after: estimate")},
+           {"convergence.png", convergence}}) {
+    status = WriteImage(out + "/" + name, picture);
+    if (!status.ok()) return fail(status);
+    outcome->pictures.push_back(out + "/" + name);
+  }
+  if (!outcome->converged) {
+    std::fprintf(stderr, "stcalib calibrate: %s\n", outcome->reason.c_str());
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+int RunCalibrate() {
+  if (FLAGS_loss != "cauchy" && FLAGS_loss != "huber") {
+    return UsageError("calibrate", "--loss must be cauchy or huber");
+  }
+  CalibrateOutcome outcome;
+  const int code = RunCalibrateJob(CalibrateJobFromFlags(), &outcome);
+  if (outcome.reports.empty()) return code;
+  const CalibrationError& e = outcome.error;
+  std::printf("%s after %zu frames (%s)\n", outcome.converged ? "converged" : "NOT converged",
+              outcome.reports.size(), outcome.reason.c_str());
+  std::printf("%s: rotation %.3f deg (roll %+.3f, pitch %+.3f, yaw %+.3f), translation %.3f m, "
+              "time offset %+.2f ms (estimate %+.2f ms)\n",
+              outcome.has_truth ? "error vs ground truth" : "agreement with the drive calibration",
+              e.rotation_deg, e.roll_deg, e.pitch_deg, e.yaw_deg, e.translation_norm_m,
+              1000 * e.time_offset_s, 1000 * outcome.estimate.time_offset_s);
+  std::printf("mean %.1f ms per frame; outputs in %s\n", outcome.mean_frame_ms, FLAGS_out.c_str());
+  return code;
+}
+
+}  // namespace stcalib::cli

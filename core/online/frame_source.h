@@ -1,0 +1,44 @@
+#pragma once
+
+#include <memory>
+
+#include "core/features/image_features.h"
+#include "core/features/lidar_frame.h"
+#include "core/io/drive.h"
+#include "core/motion/drive_motion.h"
+#include "core/score/calibration_frame.h"
+#include "core/types/status.h"
+
+namespace stcalib {
+
+struct FrameSourceOptions {
+  ImageFeatureOptions image;
+  LidarFeatureOptions lidar;
+  LocalMapOptions local_map;
+  bool suppress_texture = false;  ///< score maps are the texture-suppressed IDTs
+  bool oriented_maps = true;      ///< vertical/horizontal LiDAR edges read their own maps
+
+  FrameSourceOptions() { image.pyramid_basins_px = {60, 30}; }
+  Status Validate() const;
+};
+
+// Turns the frames of a drive into CalibrationFrames, in time order: image features, the local
+// map of LiDAR edges (de-skewed, dynamic points removed), the LiDAR twist at the image time and
+// the stamp gap. Sweeps are cached, so a sequential pass computes each one once.
+class DriveFrameSource {
+ public:
+  // Needs the drive's oxts (motion model); errors say why not.
+  static Status Create(const Drive* drive, const FrameSourceOptions& options,
+                       std::unique_ptr<DriveFrameSource>* source);
+  Status Load(size_t frame, CalibrationFrame* out);
+  const DriveMotion& motion() const { return motion_; }
+
+ private:
+  DriveFrameSource(const Drive* drive, const FrameSourceOptions& options) : drive_(drive), options_(options) {}
+  const Drive* drive_;
+  FrameSourceOptions options_;
+  DriveMotion motion_;
+  std::unique_ptr<SweepCache> cache_;
+};
+
+}  // namespace stcalib

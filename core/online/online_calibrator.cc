@@ -1,0 +1,172 @@
+#include "core/online/online_calibrator.h"
+
+#include <chrono>
+#include <cmath>
+
+#include <glog/logging.h>
+
+namespace stcalib {
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Keeps the observable axes of `candidate` and the old values of the others.
+CalibrationState KeepObservableAxes(const CalibrationState& old, const CalibrationState& candidate,
+                                    const std::array<bool, kNumAxes>& observable) {
+  const Eigen::Vector3d rotation =
+      LogSO3(old.T_camera_lidar.linear().transpose() * candidate.T_camera_lidar.linear());
+  const Eigen::Vector3d translation =
+      candidate.T_camera_lidar.translation() - old.T_camera_lidar.translation();
+  Eigen::Vector3d r = Eigen::Vector3d::Zero(), t = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 3; ++k) {
+    if (observable[k]) r[k] = rotation[k];
+    if (observable[3 + k]) t[k] = translation[k];
+  }
+  return Step(old, r, t,
+              observable[6] ? candidate.time_offset_s - old.time_offset_s : 0.0);
+}
+
+}  // namespace
+
+Status OnlineCalibratorOptions::Validate() const {
+  if (window_frames < 1) return Status::Error("online: window_frames must be >= 1");
+  STCALIB_RETURN_IF_ERROR(search.Validate());
+  return refine.Validate();
+}
+
+OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
+                                   const CalibrationState& initial)
+    : options_(options), state_(initial) {
+  CHECK(options_.Validate().ok()) << options_.Validate().message();
+  options_.search.time_offset_bound_s = options_.time_offset_bound_s;
+  options_.refine.time_offset_bound_s = options_.time_offset_bound_s;
+  state_.time_offset_s = std::clamp(state_.time_offset_s, -options_.time_offset_bound_s,
+                                    options_.time_offset_bound_s);
+  anchor_ = state_;
+}
+
+std::shared_ptr<const CalibrationFrame> OnlineCalibrator::Prune(
+    std::shared_ptr<const CalibrationFrame> frame) const {
+  // Keep the points that project inside the image (with a margin) at the current estimate, and
+  // score only those: a score over all points would reward calibrations that pull outside
+  // points into the image, and run away in translation.
+  auto pruned = std::make_shared<CalibrationFrame>(*frame);
+  pruned->points_lidar.clear();
+  pruned->kinds.clear();
+  const double mu = -options_.point_margin * frame->camera.width;
+  const double mv = -options_.point_margin * frame->camera.height;
+  const double e = frame->e0_s + state_.time_offset_s;
+  for (size_t i = 0; i < frame->size(); ++i) {
+    const Eigen::Vector3d p =
+        state_.T_camera_lidar * ApplyLidarMotion<double>(frame->twist, e, frame->points_lidar[i]);
+    Eigen::Vector2d pixel;
+    double depth;
+    if (!frame->camera.Project<double>(p, &pixel, &depth)) continue;
+    if (pixel.x() < -mu || pixel.y() < -mv || pixel.x() > frame->camera.width + mu ||
+        pixel.y() > frame->camera.height + mv) {
+      continue;
+    }
+    pruned->points_lidar.push_back(frame->points_lidar[i]);
+    pruned->kinds.push_back(frame->kinds[i]);
+  }
+  return pruned;
+}
+
+std::vector<const CalibrationFrame*> OnlineCalibrator::SearchWindow() const {
+  std::vector<const CalibrationFrame*> frames;
+  const size_t n = std::min<size_t>(window_.size(), options_.window_frames);
+  for (size_t k = window_.size() - n; k < window_.size(); ++k) frames.push_back(window_[k].get());
+  return frames;
+}
+
+FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> frame) {
+  FrameReport report;
+  report.frame = frame->index;
+  report.before = state_;
+  window_.push_back(Prune(frame));
+  while (static_cast<int>(window_.size()) > std::max(options_.window_frames, options_.refine_frames)) {
+    window_.pop_front();
+  }
+  const std::vector<const CalibrationFrame*> frames = SearchWindow();
+  for (const CalibrationFrame* f : frames) report.points += static_cast<int>(f->size());
+  std::vector<const CalibrationFrame*> refine_frames;
+  for (size_t k = window_.size() > static_cast<size_t>(options_.refine_frames)
+                      ? window_.size() - options_.refine_frames
+                      : 0;
+       k < window_.size(); ++k) {
+    refine_frames.push_back(window_[k].get());
+  }
+  if (report.points < 30) {
+    report.reason = "too few LiDAR edge points in the image (" + std::to_string(report.points) +
+                    "): estimate kept";
+    report.after = state_;
+    return report;
+  }
+  WindowScorer scorer(frames, options_.score);
+  report.score_before = scorer.Evaluate(state_, -1);
+
+  // Search: coarse-to-fine when lost, the finest map alone when tracking.
+  auto start = std::chrono::steady_clock::now();
+  AdaptiveGridSearchOptions search_options = options_.search;
+  report.gray_rate_before = scorer.GrayRate(state_);
+  report.health_before = HealthScore(&scorer, state_);
+  report.coarse_search = report.health_before < options_.lost_health ||
+                         static_cast<int>(frames.size()) < options_.window_frames;
+  search_options.first_level = report.coarse_search ? 0 : scorer.num_levels() - 1;
+  report.search = AdaptiveGridSearch(&scorer, state_, anchor_, search_options);
+  report.search_ms = MillisecondsSince(start);
+
+  // Refine from the search result, with a weak prior towards it.
+  start = std::chrono::steady_clock::now();
+  report.refine =
+      Refine(refine_frames, report.search.state, report.search.state, anchor_, options_.refine);
+  report.refine_ms = MillisecondsSince(start);
+
+  // Acceptance, judged on all the refinement's frames (a longer and steadier window than the
+  // search's): the best of the refined estimate (unobservable axes held) and the search result,
+  // when it scores at least as well as the current estimate.
+  WindowScorer long_scorer(refine_frames, options_.score);
+  const double before_long = long_scorer.Evaluate(state_, -1).score;
+  std::vector<std::pair<CalibrationState, std::string>> candidates;
+  if (report.refine.usable) {
+    candidates.emplace_back(KeepObservableAxes(state_, report.refine.state, report.refine.observable),
+                            "refined");
+  }
+  candidates.emplace_back(report.search.state, "search");
+  report.after = state_;
+  report.reason = "no candidate scored better: estimate kept";
+  double best = before_long;
+  for (const auto& [candidate, name] : candidates) {
+    if (!WithinBounds(candidate, anchor_, search_options)) continue;
+    const double value = long_scorer.Evaluate(candidate, -1).score;
+    if (value < best) continue;
+    best = value;
+    report.after = candidate;
+    report.accepted = true;
+    report.reason = name;
+    if (name == "refined") {
+      for (int k = 0; k < kNumAxes; ++k) {
+        if (!report.refine.observable[k]) report.reason += std::string(", held ") + kAxisNames[k];
+      }
+    }
+  }
+  // While tracking, move only part of the way (a first-order filter over frames): single windows
+  // scatter, their average does not. A lost estimate jumps.
+  if (report.accepted && !report.coarse_search && options_.tracking_gain < 1.0) {
+    const CalibrationState& c = report.after;
+    const double g = options_.tracking_gain;
+    report.after = Step(state_,
+                        g * LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear()),
+                        g * (c.T_camera_lidar.translation() - state_.T_camera_lidar.translation()),
+                        g * (c.time_offset_s - state_.time_offset_s));
+  }
+  report.score_after = scorer.Evaluate(report.after, -1);
+  state_ = report.after;
+  report.gray_rate_after = scorer.GrayRate(state_);
+  report.health = HealthScore(&scorer, state_);
+  return report;
+}
+
+}  // namespace stcalib

@@ -1,0 +1,77 @@
+#pragma once
+
+#include <deque>
+#include <memory>
+#include <string>
+
+#include "core/refine/refine.h"
+#include "core/score/calibration_frame.h"
+#include "core/score/score.h"
+#include "core/search/adaptive_grid_search.h"
+#include "core/types/calibration.h"
+#include "core/types/status.h"
+
+namespace stcalib {
+
+struct OnlineCalibratorOptions {
+  int window_frames = 3;              ///< sliding window of frames searched together
+  int refine_frames = 10;             ///< the refinement uses this many latest frames
+  ScoreOptions score;
+  AdaptiveGridSearchOptions search;
+  RefineOptions refine;
+  double time_offset_bound_s = 0.15;  ///< |δ| bound for search and refinement [s]
+  // Health (method.md §7) below this at the current estimate, or a window not yet full, means
+  // the estimate may be far off: the search runs coarse-to-fine from the widest map instead of
+  // on the finest one only.
+  double lost_health = 0.9;
+  // Points are kept when they project inside the image shrunk by this share of its size on
+  // each side, at the estimate when their frame arrives.
+  double point_margin = 0.02;
+  // While tracking (not lost), an accepted update moves this share of the way to the new
+  // estimate: a first-order filter that averages the scatter of single windows.
+  double tracking_gain = 1.0;
+
+  Status Validate() const;
+};
+
+struct FrameReport {
+  int frame = 0;
+  CalibrationState before, after;
+  bool accepted = false;
+  std::string reason;        ///< why the update was (not) taken
+  ScoreValue score_before, score_after;  ///< on the finest score map
+  double gray_rate_before = 0, gray_rate_after = 0;  ///< on the plain IDT
+  double health_before = 0;  ///< method.md §7, at `before`
+  double health = 0;         ///< method.md §7, at `after`
+  bool coarse_search = false;
+  SearchResult search;
+  RefineResult refine;
+  double search_ms = 0, refine_ms = 0;
+  int points = 0;
+};
+
+// Online calibration (method.md §7): frames in time order; per frame a search step and a refine
+// over the window; an update is taken only when the window score does not get worse and the axes
+// it moves are observable (an unobservable axis keeps its value); |δ| stays within its bound.
+// It only sequences the stages; the maths lives in score/, search/ and refine/.
+class OnlineCalibrator {
+ public:
+  OnlineCalibrator(const OnlineCalibratorOptions& options, const CalibrationState& initial);
+
+  FrameReport AddFrame(std::shared_ptr<const CalibrationFrame> frame);
+  const CalibrationState& state() const { return state_; }
+  // Replaces the estimate (the paper's disturbance protocol); the bounds stay where they were.
+  void SetState(const CalibrationState& state) { state_ = state; }
+  // The frames the last search used (the latest window_frames).
+  std::vector<const CalibrationFrame*> SearchWindow() const;
+
+ private:
+  std::shared_ptr<const CalibrationFrame> Prune(std::shared_ptr<const CalibrationFrame> frame) const;
+
+  OnlineCalibratorOptions options_;
+  CalibrationState state_;
+  CalibrationState anchor_;  ///< the initial calibration: the search's bounds are around it
+  std::deque<std::shared_ptr<const CalibrationFrame>> window_;  // the last refine_frames frames
+};
+
+}  // namespace stcalib

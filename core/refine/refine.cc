@@ -1,0 +1,188 @@
+#include "core/refine/refine.h"
+
+#include <cmath>
+#include <memory>
+
+#include <ceres/ceres.h>
+#include <ceres/product_manifold.h>
+#include <glog/logging.h>
+
+#include "cost_functions/calibration_prior_cost.h"
+#include "cost_functions/edge_alignment_cost.h"
+
+namespace stcalib {
+
+const std::array<const char*, kNumAxes> kAxisNames = {
+    "roll_deg", "pitch_deg", "yaw_deg", "x_m", "y_m", "z_m", "time_offset_s"};
+
+Status RefineOptions::Validate() const {
+  if (!(loss_scale_px > 0) || !(prior_sigma_rotation_deg > 0) || !(prior_sigma_translation_m > 0) ||
+      !(prior_sigma_time_s > 0) || !(time_offset_bound_s >= 0) || max_iterations < 1 ||
+      max_points_per_frame < 0) {
+    return Status::Error("refine: scales, sigmas and caps must be positive");
+  }
+  if (!(horizontal_weight >= 0 && horizontal_weight <= 1)) {
+    return Status::Error("refine: horizontal_weight must be in [0, 1]");
+  }
+  return Status::Ok();
+}
+
+RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
+                    const CalibrationState& start, const CalibrationState& rotation_prior,
+                    const CalibrationState& mount_prior, const RefineOptions& options) {
+  CHECK(options.Validate().ok()) << options.Validate().message();
+  RefineResult result;
+  result.state = start;
+
+  // Interpolators over each frame's smoothed, capped distance map.
+  std::vector<std::unique_ptr<DistanceGrid>> grids;
+  std::vector<std::unique_ptr<DistanceInterpolator>> interpolators;
+  const Eigen::Quaterniond q_start(start.T_camera_lidar.linear());
+  double pose[7] = {q_start.x(), q_start.y(), q_start.z(), q_start.w(),
+                    start.T_camera_lidar.translation().x(), start.T_camera_lidar.translation().y(),
+                    start.T_camera_lidar.translation().z()};
+  double delta = std::clamp(start.time_offset_s, -options.time_offset_bound_s,
+                            options.time_offset_bound_s);
+  ceres::Problem problem;
+  problem.AddParameterBlock(pose, 7,
+                            new ceres::ProductManifold<ceres::EigenQuaternionManifold,
+                                                       ceres::EuclideanManifold<3>>());
+  problem.AddParameterBlock(&delta, 1);
+  ceres::LossFunction* loss =
+      options.loss == RefineOptions::Loss::kCauchy
+          ? static_cast<ceres::LossFunction*>(new ceres::CauchyLoss(options.loss_scale_px))
+          : new ceres::HuberLoss(options.loss_scale_px);
+  for (const CalibrationFrame* frame : window) {
+    if (frame->distance_px[0].empty() || frame->distance_px[1].empty() || frame->size() == 0) continue;
+    const DistanceInterpolator* by_kind[2];
+    double cap = 0;
+    for (int kind = 0; kind < 2; ++kind) {
+      const cv::Mat& map = frame->distance_px[kind];
+      CHECK(map.isContinuous() && map.type() == CV_32F);
+      grids.push_back(std::make_unique<DistanceGrid>(map.ptr<float>(), 0, map.rows, 0, map.cols));
+      interpolators.push_back(std::make_unique<DistanceInterpolator>(*grids.back()));
+      by_kind[kind] = interpolators.back().get();
+      double max_value = 0;
+      cv::minMaxLoc(map, nullptr, &max_value);
+      cap = std::max(cap, max_value);
+    }
+    const size_t n = frame->size();
+    const size_t keep = options.max_points_per_frame > 0
+                            ? std::min<size_t>(n, options.max_points_per_frame)
+                            : n;
+    for (size_t k = 0; k < keep; ++k) {
+      const size_t i = k * n / keep;
+      const double w = frame->kinds[i] == EdgeKind::kHorizontal ? options.horizontal_weight
+                                                                : 1.0 - options.horizontal_weight;
+      if (w <= 0) continue;
+      problem.AddResidualBlock(
+          EdgeAlignmentCost::Create(frame->points_lidar[i], w, frame->twist, frame->e0_s,
+                                    &frame->camera, by_kind[static_cast<int>(frame->kinds[i])], cap),
+          loss, pose, &delta);
+      ++result.residuals;
+    }
+  }
+  if (result.residuals < 20) {
+    result.message = "too few LiDAR edge points to refine (" + std::to_string(result.residuals) + ")";
+    return result;
+  }
+  // Translation prior: weak across the direction of travel, per point along it.
+  const LidarTwist& twist = window.back()->twist;
+  const Eigen::Vector3d forward =
+      twist.linear_m_s.norm() > 0.5
+          ? Eigen::Vector3d(start.T_camera_lidar.linear() * twist.linear_m_s.normalized())
+          : Eigen::Vector3d::UnitZ();
+  const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - forward * forward.transpose();
+  const double n = static_cast<double>(result.residuals);
+  const Eigen::Matrix3d sqrt_information = across / options.prior_sigma_translation_m +
+                                           std::sqrt(n) / options.prior_sigma_forward_m *
+                                               forward * forward.transpose();
+  const Eigen::Quaterniond q_prior(rotation_prior.T_camera_lidar.linear());
+  problem.AddResidualBlock(
+      CalibrationPriorCost::Create(q_prior, mount_prior.T_camera_lidar.translation(),
+                                   mount_prior.time_offset_s,
+                                   options.prior_sigma_rotation_deg * M_PI / 180.0,
+                                   sqrt_information, options.prior_sigma_time_s),
+      nullptr, pose, &delta);
+  problem.SetParameterLowerBound(&delta, 0, -options.time_offset_bound_s);
+  problem.SetParameterUpperBound(&delta, 0, options.time_offset_bound_s);
+  if (!options.estimate_time_offset) problem.SetParameterBlockConstant(&delta);
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.num_threads = 1;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  result.iterations = static_cast<int>(summary.iterations.size());
+  result.initial_cost = summary.initial_cost;
+  result.final_cost = summary.final_cost;
+  result.usable = summary.IsSolutionUsable();
+  if (!result.usable) {
+    result.message = "solver: " + summary.message;
+    return result;
+  }
+  const Eigen::Quaterniond q(pose[3], pose[0], pose[1], pose[2]);
+  result.state.T_camera_lidar =
+      MakeRigid(q.normalized().toRotationMatrix(), Eigen::Vector3d(pose[4], pose[5], pose[6]));
+  result.state.time_offset_s = delta;
+
+  // Covariance in the tangent space [rotation (3), translation (3)] + [δ], scaled by the residual
+  // variance estimated from the final cost.
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.null_space_rank = -1;
+  ceres::Covariance covariance(covariance_options);
+  std::vector<const double*> blocks = {pose};
+  if (options.estimate_time_offset) blocks.push_back(&delta);
+  if (covariance.Compute(blocks, &problem)) {
+    const int n = options.estimate_time_offset ? 7 : 6;
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(n, n);
+    if (covariance.GetCovarianceMatrixInTangentSpace(blocks, C.data())) {
+      const double dof = std::max(1, result.residuals - n);
+      const double sigma2 = 2.0 * summary.final_cost / dof;
+      // Tangent of EigenQuaternionManifold: q ⊕ δ = [cos|δ|, sin|δ|·δ/|δ|] ⊗ q, a rotation of
+      // 2δ on the camera side; about the LiDAR axes that is 2·Rᵀ·δ.
+      Eigen::Matrix<double, kNumAxes, kNumAxes> J = Eigen::Matrix<double, kNumAxes, kNumAxes>::Zero();
+      J.block<3, 3>(0, 0) = 2.0 * (180.0 / M_PI) * result.state.T_camera_lidar.linear().transpose();
+      J.block<3, 3>(3, 3).setIdentity();
+      J(6, 6) = 1.0;
+      Eigen::Matrix<double, kNumAxes, kNumAxes> full = Eigen::Matrix<double, kNumAxes, kNumAxes>::Zero();
+      full.topLeftCorner(n, n) = C * sigma2;
+      const Eigen::Matrix<double, kNumAxes, kNumAxes> axes = J * full * J.transpose();
+      for (int k = 0; k < kNumAxes; ++k) result.std_dev[k] = std::sqrt(std::max(0.0, axes(k, k)));
+      if (!options.estimate_time_offset) result.std_dev[6] = 0;
+      for (int a = 0; a < kNumAxes; ++a) {
+        for (int b = 0; b < kNumAxes; ++b) {
+          const double d = result.std_dev[a] * result.std_dev[b];
+          result.correlation(a, b) = d > 0 ? axes(a, b) / d : (a == b ? 1.0 : 0.0);
+        }
+      }
+      // δ against the translation along the direction of travel (camera frame).
+      const LidarTwist& twist = window.back()->twist;
+      if (options.estimate_time_offset && twist.linear_m_s.norm() > 0.5) {
+        const Eigen::Vector3d forward =
+            result.state.T_camera_lidar.linear() * twist.linear_m_s.normalized();
+        const double var_f = forward.transpose() * axes.block<3, 3>(3, 3) * forward;
+        const double cov_fd = forward.dot(axes.block<3, 1>(3, 6));
+        const double d = std::sqrt(std::max(0.0, var_f)) * result.std_dev[6];
+        result.time_forward_correlation = d > 0 ? cov_fd / d : 0.0;
+      }
+      result.covariance_ok = true;
+    }
+  }
+  if (!result.covariance_ok) result.message = "covariance rank-deficient";
+  const double thresholds[kNumAxes] = {
+      options.observable_rotation_deg,  options.observable_rotation_deg,
+      options.observable_rotation_deg,  options.observable_translation_m,
+      options.observable_translation_m, options.observable_translation_m,
+      options.observable_time_s};
+  for (int k = 0; k < kNumAxes; ++k) {
+    result.observable[k] = result.covariance_ok && result.std_dev[k] < thresholds[k];
+  }
+  if (!options.estimate_time_offset) result.observable[6] = false;
+  return result;
+}
+
+}  // namespace stcalib

@@ -1,0 +1,72 @@
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/score/calibration_frame.h"
+#include "core/types/calibration.h"
+#include "core/types/status.h"
+
+namespace stcalib {
+
+// Joint refinement of rotation, translation and time offset over a window of frames with Ceres
+// (method.md §6): one EdgeAlignmentCost per LiDAR edge point under a robust loss, plus a weak
+// CalibrationPriorCost towards the search result. ceres::Covariance then gives per-axis
+// standard deviations; an axis is observable when its std is under a threshold.
+struct RefineOptions {
+  enum class Loss { kHuber, kCauchy };
+  Loss loss = Loss::kCauchy;
+  double loss_scale_px = 3.0;            ///< robust-loss scale [px]
+  double horizontal_weight = 0.5;        ///< w of method.md §6
+  // Weak priors: rotation towards the search result, translation and δ towards the mount (the
+  // initial calibration); they hold only what the data leaves free (δ against the forward
+  // translation on a straight road, method.md §10).
+  double prior_sigma_rotation_deg = 2.0;    ///< [deg]
+  double prior_sigma_translation_m = 0.05;  ///< lateral and vertical [m]
+  // Along the direction of travel the translation is held firmly (per point, i.e. the sigma is
+  // scaled by √N): there data cannot tell it from δ on a straight road (method.md §10).
+  double prior_sigma_forward_m = 0.05;
+  double prior_sigma_time_s = 0.03;         ///< [s]
+  double time_offset_bound_s = 0.15;     ///< |δ| bound [s]
+  bool estimate_time_offset = true;
+  int max_points_per_frame = 800;
+  int max_iterations = 30;
+  // Observability thresholds on the standard deviations.
+  double observable_rotation_deg = 0.15;
+  double observable_translation_m = 0.04;
+  double observable_time_s = 0.006;
+
+  Status Validate() const;
+};
+
+// Axes in result order: roll, pitch, yaw (about the LiDAR axes) [deg], x, y, z (translation of
+// T_camera_lidar) [m], time offset [s].
+constexpr int kNumAxes = 7;
+extern const std::array<const char*, kNumAxes> kAxisNames;  // roll_deg, ..., time_offset_s
+
+struct RefineResult {
+  CalibrationState state;
+  bool usable = false;
+  std::string message;
+  int residuals = 0;
+  int iterations = 0;
+  double initial_cost = 0, final_cost = 0;
+  bool covariance_ok = false;
+  Eigen::Matrix<double, kNumAxes, 1> std_dev = Eigen::Matrix<double, kNumAxes, 1>::Constant(1e9);
+  Eigen::Matrix<double, kNumAxes, kNumAxes> correlation =
+      Eigen::Matrix<double, kNumAxes, kNumAxes>::Identity();
+  std::array<bool, kNumAxes> observable{};
+  // Correlation of δ with the translation along the direction of travel (camera frame).
+  double time_forward_correlation = 0;
+};
+
+// `rotation_prior` holds the rotation (the search result), `mount_prior` the translation and
+// the time offset (the initial calibration and δ0).
+RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
+                    const CalibrationState& start, const CalibrationState& rotation_prior,
+                    const CalibrationState& mount_prior, const RefineOptions& options);
+
+}  // namespace stcalib

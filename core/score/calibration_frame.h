@@ -1,0 +1,39 @@
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "core/features/image_features.h"
+#include "core/features/lidar_edges.h"
+#include "core/motion/motion_model.h"
+#include "core/types/camera_model.h"
+
+namespace stcalib {
+
+// One image with its LiDAR edge points: everything the score, the search and the refinement read.
+struct CalibrationFrame {
+  int index = 0;         ///< frame of the drive
+  double e0_s = 0;       ///< LiDAR stamp − camera stamp [s]; the gap is e = e0 + δ
+  LidarTwist twist;      ///< LiDAR body twist at the image time (motion model, method.md §3)
+  CameraModel camera;    ///< size read from the image
+  std::vector<Eigen::Vector3d> points_lidar;  ///< edge points (local map), at the LiDAR stamp
+  std::vector<EdgeKind> kinds;
+  ImageFeatures image;   ///< distance_raw_px for overlays
+  // Maps per edge kind, indexed by EdgeKind (0 vertical, 1 horizontal): with oriented maps a
+  // vertical LiDAR edge reads the map of near-vertical image edges only; otherwise both entries
+  // share the same map.
+  // Score maps, coarsest first, finest last (IDTs of growing sharpness).
+  std::array<std::vector<cv::Mat>, 2> score_maps;
+  // Plain (not suppressed) IDT: its mean at the projected points is the gray rate that picks
+  // the search's step sizes (method.md §6).
+  std::array<cv::Mat, 2> gray_map;
+  // Smoothed, capped distance maps for the refinement's bicubic residuals [px].
+  std::array<cv::Mat, 2> distance_px;
+
+  size_t size() const { return points_lidar.size(); }
+};
+
+}  // namespace stcalib

@@ -1,0 +1,148 @@
+#include "core/score/score.h"
+
+#include <cmath>
+#include <limits>
+
+#include <glog/logging.h>
+
+namespace stcalib {
+namespace {
+
+// Bilinear sample of a CV_32F map; 0 outside.
+inline float Sample(const cv::Mat& map, double u, double v) {
+  if (!(u >= 0 && v >= 0 && u < map.cols - 1 && v < map.rows - 1)) return 0.0f;
+  const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
+  const float fu = static_cast<float>(u - u0), fv = static_cast<float>(v - v0);
+  const float* row0 = map.ptr<float>(v0);
+  const float* row1 = map.ptr<float>(v0 + 1);
+  return (1 - fv) * ((1 - fu) * row0[u0] + fu * row0[u0 + 1]) +
+         fv * ((1 - fu) * row1[u0] + fu * row1[u0 + 1]);
+}
+
+}  // namespace
+
+CalibrationState Step(const CalibrationState& state, const Eigen::Vector3d& rotation_rad,
+                      const Eigen::Vector3d& translation_m, double time_offset_s) {
+  CalibrationState out = state;
+  out.T_camera_lidar.linear() = state.T_camera_lidar.linear() * ExpSO3(rotation_rad);
+  out.T_camera_lidar.translation() += translation_m;
+  out.time_offset_s += time_offset_s;
+  return out;
+}
+
+WindowScorer::WindowScorer(std::vector<const CalibrationFrame*> frames, const ScoreOptions& options)
+    : frames_(std::move(frames)), options_(options) {
+  for (const CalibrationFrame* f : frames_) {
+    CHECK(f != nullptr);
+    std::vector<int> selected;
+    const size_t n = f->size();
+    const size_t keep = options.max_points_per_frame > 0
+                            ? std::min<size_t>(n, options.max_points_per_frame)
+                            : n;
+    for (size_t k = 0; k < keep; ++k) selected.push_back(static_cast<int>(k * n / keep));
+    std::vector<float> weights;
+    std::vector<uint8_t> kinds;
+    for (int i : selected) {
+      kinds.push_back(static_cast<uint8_t>(f->kinds[i]));
+      weights.push_back(static_cast<float>(f->kinds[i] == EdgeKind::kHorizontal
+                                               ? options.horizontal_weight
+                                               : 1.0 - options.horizontal_weight));
+    }
+    selected_.push_back(std::move(selected));
+    weights_.push_back(std::move(weights));
+    kinds_.push_back(std::move(kinds));
+  }
+  moved_.resize(frames_.size());
+}
+
+int WindowScorer::num_levels() const {
+  int levels = std::numeric_limits<int>::max();
+  for (const CalibrationFrame* f : frames_) {
+    levels = std::min<int>(levels, std::min(f->score_maps[0].size(), f->score_maps[1].size()));
+  }
+  return frames_.empty() ? 0 : levels;
+}
+
+const std::vector<Eigen::Vector3d>& WindowScorer::Moved(size_t frame, double time_offset_s) {
+  if (time_offset_s != cached_time_offset_s_) {
+    for (size_t f = 0; f < frames_.size(); ++f) {
+      const CalibrationFrame& cf = *frames_[f];
+      const double e = cf.e0_s + time_offset_s;
+      moved_[f].resize(selected_[f].size());
+      for (size_t k = 0; k < selected_[f].size(); ++k) {
+        moved_[f][k] = ApplyLidarMotion<double>(cf.twist, e, cf.points_lidar[selected_[f][k]]);
+      }
+    }
+    cached_time_offset_s_ = time_offset_s;
+  }
+  return moved_[frame];
+}
+
+ScoreValue WindowScorer::Evaluate(const CalibrationState& state, int level) {
+  return EvaluateOn(state, [level](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
+    const int maps = static_cast<int>(cf.score_maps[kind].size());
+    const int l = level < 0 ? maps + level : level;
+    CHECK(l >= 0 && l < maps) << "score level " << level << " of " << maps;
+    return cf.score_maps[kind][l];
+  });
+}
+
+double WindowScorer::GrayRate(const CalibrationState& state) {
+  return EvaluateOn(state, [](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
+           return cf.gray_map[kind].empty() ? cf.score_maps[kind].back() : cf.gray_map[kind];
+         })
+      .gray_rate;
+}
+
+template <typename MapOf>
+ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& map_of) {
+  ScoreValue value;
+  double weight_sum = 0;
+  for (size_t f = 0; f < frames_.size(); ++f) {
+    const CalibrationFrame& cf = *frames_[f];
+    const cv::Mat* maps[2] = {&map_of(cf, 0), &map_of(cf, 1)};
+    const std::vector<Eigen::Vector3d>& moved = Moved(f, state.time_offset_s);
+    // h = K·R_rect·(R·p + t) + p4 = M·p + b.
+    const Eigen::Matrix3d KR = cf.camera.P_rect_02.leftCols<3>() * cf.camera.R_rect_00;
+    const Eigen::Matrix3d M = KR * state.T_camera_lidar.linear();
+    const Eigen::Vector3d b = KR * state.T_camera_lidar.translation() + cf.camera.P_rect_02.col(3);
+    const Eigen::Vector3d depth_row = cf.camera.R_rect_00.row(2) * state.T_camera_lidar.linear();
+    const double depth_offset = cf.camera.R_rect_00.row(2).dot(state.T_camera_lidar.translation());
+    for (size_t k = 0; k < moved.size(); ++k) {
+      const float w = weights_[f][k];
+      weight_sum += w;
+      if (depth_row.dot(moved[k]) + depth_offset < cf.camera.min_depth_m) continue;
+      const Eigen::Vector3d h = M * moved[k] + b;
+      const double u = h.x() / h.z(), v = h.y() / h.z();
+      const cv::Mat& map = *maps[kinds_[f][k]];
+      const float s = Sample(map, u, v);
+      if (u >= 0 && v >= 0 && u < map.cols && v < map.rows) ++value.projected;
+      value.score += w * s;
+    }
+  }
+  value.gray_rate = weight_sum > 0 ? value.score / 255.0 / weight_sum : 0.0;
+  value.weight_sum = weight_sum;
+  return value;
+}
+
+double HealthScore(WindowScorer* scorer, const CalibrationState& state, double rotation_deg,
+                   double translation_m) {
+  const double centre = scorer->Evaluate(state, -1).score;
+  const double r = rotation_deg * M_PI / 180.0;
+  int worse = 0, total = 0;
+  for (int code = 0; code < 729; ++code) {
+    if (code == 364) continue;  // the centre
+    int c = code;
+    Eigen::Matrix<double, 6, 1> d;
+    for (int k = 0; k < 6; ++k) {
+      d[k] = c % 3 - 1;
+      c /= 3;
+    }
+    const CalibrationState n = Step(state, r * d.head<3>(), translation_m * d.tail<3>(), 0.0);
+    worse += scorer->Evaluate(n, -1).score < centre;
+    ++total;
+  }
+  return static_cast<double>(worse) / total;
+}
+
+}  // namespace stcalib

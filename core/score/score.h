@@ -1,0 +1,69 @@
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/score/calibration_frame.h"
+#include "core/types/calibration.h"
+
+namespace stcalib {
+
+// Score of a calibration (method.md §6): over projected LiDAR edge points, the score map at the
+// projected pixel (bilinear), horizontal points weighted w and vertical ones 1 − w. The gray
+// rate is score / 255 / (weighted number of points): the mean map value, 0..1.
+struct ScoreOptions {
+  double horizontal_weight = 0.5;  ///< w of method.md §6
+  int max_points_per_frame = 600;  ///< evenly thinned for speed; 0 = all
+};
+
+struct ScoreValue {
+  double score = 0;      ///< weighted sum of map values
+  double gray_rate = 0;  ///< score / 255 / weight sum
+  int projected = 0;     ///< points that landed in the image
+  double weight_sum = 0;  ///< sum of the point weights (score = 255·gray_rate·weight_sum)
+};
+
+// Evaluates many candidate calibrations on a window of frames fast: the points carried by the
+// motion model are cached per time offset, and each candidate costs one 3×3 product per point.
+class WindowScorer {
+ public:
+  WindowScorer(std::vector<const CalibrationFrame*> frames, const ScoreOptions& options);
+
+  // `level` indexes CalibrationFrame::score_maps (negative counts from the finest: −1).
+  ScoreValue Evaluate(const CalibrationState& state, int level);
+  // Gray rate on the frames' plain IDT (CalibrationFrame::gray_map; the finest score map when
+  // absent).
+  double GrayRate(const CalibrationState& state);
+  int num_levels() const;
+  size_t num_frames() const { return frames_.size(); }
+
+ private:
+  struct FramePoints {
+    std::vector<Eigen::Vector3d> moved;  // Tv(e0 + δ)·p for the cached δ
+    std::vector<float> weight;
+  };
+  const std::vector<Eigen::Vector3d>& Moved(size_t frame, double time_offset_s);
+  // Evaluates on the map `map_of(frame, kind)`.
+  template <typename MapOf>
+  ScoreValue EvaluateOn(const CalibrationState& state, const MapOf& map_of);
+
+  std::vector<const CalibrationFrame*> frames_;
+  ScoreOptions options_;
+  std::vector<std::vector<int>> selected_;  // thinned point indices per frame
+  std::vector<std::vector<float>> weights_;
+  std::vector<std::vector<uint8_t>> kinds_;
+  double cached_time_offset_s_ = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::vector<Eigen::Vector3d>> moved_;
+};
+
+// Applies a step to a calibration: rotation as roll/pitch/yaw about the LiDAR axes [rad]
+// (R·Exp(Δ)), translation in the camera frame [m], time offset [s].
+CalibrationState Step(const CalibrationState& state, const Eigen::Vector3d& rotation_rad,
+                      const Eigen::Vector3d& translation_m, double time_offset_s);
+
+// Health score (method.md §7): the share of the 728 grid neighbours at ±`rotation_deg` /
+// ±`translation_m` that score worse than `state` on the finest map.
+double HealthScore(WindowScorer* scorer, const CalibrationState& state, double rotation_deg = 1.0,
+                   double translation_m = 0.05);
+
+}  // namespace stcalib

@@ -1,0 +1,191 @@
+#include "core/search/adaptive_grid_search.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glog/logging.h>
+
+namespace stcalib {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+// The 728 neighbour directions, each component in {−1, 0, 1}.
+const std::vector<Eigen::Matrix<double, 6, 1>>& Directions(bool translation) {
+  static const std::vector<Eigen::Matrix<double, 6, 1>> all = [] {
+    std::vector<Eigen::Matrix<double, 6, 1>> d;
+    for (int code = 0; code < 729; ++code) {
+      if (code == 364) continue;
+      Eigen::Matrix<double, 6, 1> v;
+      int c = code;
+      for (int k = 0; k < 6; ++k) {
+        v[k] = c % 3 - 1;
+        c /= 3;
+      }
+      d.push_back(v);
+    }
+    return d;
+  }();
+  static const std::vector<Eigen::Matrix<double, 6, 1>> rotation_only = [] {
+    std::vector<Eigen::Matrix<double, 6, 1>> d;
+    for (const auto& v : all) {
+      if (v.tail<3>().isZero()) d.push_back(v);
+    }
+    return d;
+  }();
+  return translation ? all : rotation_only;
+}
+
+}  // namespace
+
+Status AdaptiveGridSearchOptions::Validate() const {
+  if (!(alpha1_rotation_deg > 0 && alpha2_translation_m > 0 && alpha3_rotation_deg > 0 &&
+        alpha4_translation_m > 0)) {
+    return Status::Error("search: step sizes must be > 0");
+  }
+  if (!(gamma >= 0 && gamma <= 1)) return Status::Error("search: gamma must be in [0, 1]");
+  if (max_iterations < 1 || max_follow_steps < 0) return Status::Error("search: bad iteration caps");
+  if (!(translation_prior_sigma_m > 0) || translation_prior_weight < 0) {
+    return Status::Error("search: translation prior sigma must be > 0, weight >= 0");
+  }
+  if (!(time_offset_step_s > 0) || !(time_offset_bound_s >= 0)) {
+    return Status::Error("search: time offset step must be > 0 and the bound >= 0");
+  }
+  return Status::Ok();
+}
+
+bool WithinBounds(const CalibrationState& state, const CalibrationState& anchor,
+                  const AdaptiveGridSearchOptions& options) {
+  return RotationErrorDeg(state.T_camera_lidar.linear(), anchor.T_camera_lidar.linear()) <=
+             options.max_rotation_offset_deg &&
+         (state.T_camera_lidar.translation() - anchor.T_camera_lidar.translation()).norm() <=
+             options.max_translation_offset_m &&
+         std::abs(state.time_offset_s) <= options.time_offset_bound_s + 1e-12;
+}
+
+SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& start,
+                                const CalibrationState& anchor,
+                                const AdaptiveGridSearchOptions& options) {
+  CHECK(options.Validate().ok()) << options.Validate().message();
+  // The objective: the score with the translation prior.
+  auto objective = [&](const CalibrationState& state, int level) {
+    const ScoreValue v = scorer->Evaluate(state, level);
+    const double z = (state.T_camera_lidar.translation() - anchor.T_camera_lidar.translation()).norm() /
+                     options.translation_prior_sigma_m;
+    return v.score - options.translation_prior_weight * 255.0 * v.weight_sum * z * z;
+  };
+  SearchResult result;
+  result.state = start;
+  result.start = scorer->Evaluate(start, -1);
+  const int levels = scorer->num_levels();
+  for (int level = std::clamp(options.first_level, 0, std::max(levels - 1, 0)); level < levels;
+       ++level) {
+    const bool finest = level == levels - 1;
+    const auto& directions = Directions(options.search_translation &&
+                                        (finest || !options.coarse_levels_rotation_only));
+    const bool search_time = options.search_time_offset && finest;
+    CalibrationState& state = result.state;
+    double current = objective(state, level);
+    ++result.evaluations;
+    bool large = scorer->GrayRate(state) < options.gamma;
+    for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+      const double rot = (large ? options.alpha1_rotation_deg : options.alpha3_rotation_deg) * kDegToRad;
+      const double trans = large ? options.alpha2_translation_m : options.alpha4_translation_m;
+      double best = current;
+      Eigen::Matrix<double, 6, 1> best_dir = Eigen::Matrix<double, 6, 1>::Zero();
+      for (const auto& d : directions) {
+        const CalibrationState candidate = Step(state, rot * d.head<3>(), trans * d.tail<3>(), 0.0);
+        if (!WithinBounds(candidate, anchor, options)) continue;
+        const double s = objective(candidate, level);
+        if (s > best) {
+          best = s;
+          best_dir = d;
+        }
+      }
+      result.evaluations += directions.size();
+      bool moved = false;
+      if (best > current) {
+        // Steepest-direction following.
+        state = Step(state, rot * best_dir.head<3>(), trans * best_dir.tail<3>(), 0.0);
+        current = best;
+        ++result.moves;
+        moved = true;
+        for (int k = 0; k < options.max_follow_steps; ++k) {
+          const CalibrationState next =
+              Step(state, rot * best_dir.head<3>(), trans * best_dir.tail<3>(), 0.0);
+          if (!WithinBounds(next, anchor, options)) break;
+          const double s = objective(next, level);
+          ++result.evaluations;
+          if (s <= current) break;
+          state = next;
+          current = s;
+          ++result.moves;
+        }
+      }
+      if (search_time) {
+        // 1-D δ search interleaved with the 6-DoF steps.
+        const double step = options.time_offset_step_s * (large ? 2.0 : 1.0);
+        for (double sign : {-1.0, 1.0}) {
+          for (int k = 1; k <= 3; ++k) {
+            const double delta = state.time_offset_s + sign * k * step;
+            if (std::abs(delta) > options.time_offset_bound_s) break;
+            CalibrationState candidate = state;
+            candidate.time_offset_s = delta;
+            const double s = objective(candidate, level);
+            ++result.evaluations;
+            if (s > current) {
+              state = candidate;
+              current = s;
+              moved = true;
+            }
+          }
+        }
+      }
+      if (!moved) {
+        if (large) {
+          large = false;  // adapt: refine with the small pair before stopping
+          continue;
+        }
+        break;
+      }
+      // Re-choose the pair from the gray rate on the finest map.
+      large = large && scorer->GrayRate(state) < options.gamma;
+    }
+  }
+  result.end = scorer->Evaluate(result.state, -1);
+  return result;
+}
+
+TimeOffsetProfile ProfileTimeOffset(WindowScorer* scorer, const CalibrationState& state,
+                                    double bound_s, double step_s, double ratio,
+                                    double min_separation_s) {
+  TimeOffsetProfile profile;
+  for (double d = -bound_s; d <= bound_s + 1e-12; d += step_s) {
+    CalibrationState s = state;
+    s.time_offset_s = d;
+    profile.offsets_s.push_back(d);
+    profile.scores.push_back(scorer->Evaluate(s, -1).score);
+  }
+  if (profile.scores.empty()) return profile;
+  const auto best_it = std::max_element(profile.scores.begin(), profile.scores.end());
+  const size_t best = best_it - profile.scores.begin();
+  const double floor = *std::min_element(profile.scores.begin(), profile.scores.end());
+  profile.best_s = profile.offsets_s[best];
+  // Second local maximum far enough from the best.
+  double second = floor;
+  for (size_t i = 0; i < profile.scores.size(); ++i) {
+    const bool peak = (i == 0 || profile.scores[i] >= profile.scores[i - 1]) &&
+                      (i + 1 == profile.scores.size() || profile.scores[i] >= profile.scores[i + 1]);
+    if (!peak || std::abs(profile.offsets_s[i] - profile.best_s) < min_separation_s) continue;
+    if (profile.scores[i] > second) {
+      second = profile.scores[i];
+      profile.second_peak_s = profile.offsets_s[i];
+    }
+  }
+  const double range = profile.scores[best] - floor;
+  profile.second_peak_ratio = range > 0 ? (second - floor) / range : 0.0;
+  profile.alias_suspect = profile.second_peak_ratio >= ratio;
+  return profile;
+}
+
+}  // namespace stcalib
