@@ -3,10 +3,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <random>
-
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 #include "apps/calibrate_job.h"
 #include "apps/commands.h"
@@ -47,10 +46,14 @@ nlohmann::json MatrixJson(const Rigid3d& T) {
 }
 
 nlohmann::json ErrorJson(const CalibrationError& e) {
-  return {{"rotation_deg", e.rotation_deg},   {"roll_deg", e.roll_deg},
-          {"pitch_deg", e.pitch_deg},         {"yaw_deg", e.yaw_deg},
-          {"translation_m", e.translation_norm_m}, {"x_m", e.translation_m.x()},
-          {"y_m", e.translation_m.y()},       {"z_m", e.translation_m.z()},
+  return {{"rotation_deg", e.rotation_deg},
+          {"roll_deg", e.roll_deg},
+          {"pitch_deg", e.pitch_deg},
+          {"yaw_deg", e.yaw_deg},
+          {"translation_m", e.translation_norm_m},
+          {"x_m", e.translation_m.x()},
+          {"y_m", e.translation_m.y()},
+          {"z_m", e.translation_m.z()},
           {"time_offset_s", e.time_offset_s}};
 }
 
@@ -73,7 +76,8 @@ cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
     Eigen::Vector2d pixel;
     double depth;
     if (!frame.camera.Project<double>(p, &pixel, &depth) || !frame.camera.InImage(pixel)) continue;
-    const int u = static_cast<int>(std::lround(pixel.x())), v = static_cast<int>(std::lround(pixel.y()));
+    const int u = static_cast<int>(std::lround(pixel.x())),
+              v = static_cast<int>(std::lround(pixel.y()));
     const bool near = frame.image.distance_raw_px.at<float>(v, u) <= 2.0f;
     cv::circle(canvas, cv::Point(u, v), 2, near ? cv::Scalar(60, 255, 60) : cv::Scalar(40, 40, 255),
                cv::FILLED);
@@ -113,7 +117,8 @@ CalibrateJob CalibrateJobFromFlags() {
   o.search.gamma = FLAGS_gamma;
   o.search.search_time_offset = FLAGS_estimate_time_offset;
   o.refine.estimate_time_offset = FLAGS_estimate_time_offset;
-  o.refine.loss = FLAGS_loss == "huber" ? RefineOptions::Loss::kHuber : RefineOptions::Loss::kCauchy;
+  o.refine.loss =
+      FLAGS_loss == "huber" ? RefineOptions::Loss::kHuber : RefineOptions::Loss::kCauchy;
   o.refine.loss_scale_px = FLAGS_loss_scale_px;
   o.refine.horizontal_weight = FLAGS_horizontal_weight;
   o.refine.prior_sigma_rotation_deg = FLAGS_prior_sigma_rotation_deg;
@@ -137,11 +142,14 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   status = OpenDrive(job.drive_dir, job.calib_dir, &drive);
   if (!status.ok()) return ReportError(kCommand, status);
   const int first = job.first_frame;
-  const int last = job.num_frames > 0 ? first + job.num_frames - 1 : static_cast<int>(drive.NumFrames()) - 1;
-  if (first < 0 || first >= static_cast<int>(drive.NumFrames()) || last >= static_cast<int>(drive.NumFrames())) {
-    return ReportError(kCommand, Status::Error(drive.drive_dir + ": frames " + std::to_string(first) +
-                                               ".." + std::to_string(last) + " out of range (" +
-                                               std::to_string(drive.NumFrames()) + " frames)"));
+  const int last =
+      job.num_frames > 0 ? first + job.num_frames - 1 : static_cast<int>(drive.NumFrames()) - 1;
+  if (first < 0 || first >= static_cast<int>(drive.NumFrames()) ||
+      last >= static_cast<int>(drive.NumFrames())) {
+    return ReportError(kCommand,
+                       Status::Error(drive.drive_dir + ": frames " + std::to_string(first) + ".." +
+                                     std::to_string(last) + " out of range (" +
+                                     std::to_string(drive.NumFrames()) + " frames)"));
   }
   std::unique_ptr<DriveFrameSource> source;
   status = DriveFrameSource::Create(&drive, job.source, &source);
@@ -194,27 +202,36 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       const Eigen::Vector3d d(sign() * job.disturb_rot_deg, sign() * job.disturb_rot_deg,
                               sign() * job.disturb_rot_deg);
       CalibrationState disturbed = calibrator.state();
-      disturbed.T_camera_lidar = PerturbTcameraLidar(disturbed.T_camera_lidar, d, Eigen::Vector3d::Zero());
+      disturbed.T_camera_lidar =
+          PerturbTcameraLidar(disturbed.T_camera_lidar, d, Eigen::Vector3d::Zero());
       calibrator.SetState(disturbed);
     }
     FrameReport report = calibrator.AddFrame(frame);
-    frame_ms_sum += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    frame_ms_sum +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!first_frame) first_frame = frame;
     last_frame = frame;
     outcome->reports.push_back(report);
     if (getenv("STCALIB_DEBUG")) {
-      const CalibrationError es = ComputeCalibrationError(report.search.state, outcome->reference_state);
-      const CalibrationError er = ComputeCalibrationError(report.refine.state, outcome->reference_state);
-      std::fprintf(stderr, "\n[debug] frame %d search %.3f deg %.3f m %.1f ms | refine(%d) %.3f deg %.3f m %.1f ms | %s\n", i,
-                   es.rotation_deg, es.translation_norm_m, 1000 * es.time_offset_s, report.refine.usable,
-                   er.rotation_deg, er.translation_norm_m, 1000 * er.time_offset_s, report.reason.c_str());
+      const CalibrationError es =
+          ComputeCalibrationError(report.search.state, outcome->reference_state);
+      const CalibrationError er =
+          ComputeCalibrationError(report.refine.state, outcome->reference_state);
+      std::fprintf(stderr,
+                   "\n[debug] frame %d search %.3f deg %.3f m %.1f ms | refine(%d) %.3f deg %.3f m "
+                   "%.1f ms | %s\n",
+                   i, es.rotation_deg, es.translation_norm_m, 1000 * es.time_offset_s,
+                   report.refine.usable, er.rotation_deg, er.translation_norm_m,
+                   1000 * er.time_offset_s, report.reason.c_str());
     }
     if (job.progress) {
       const CalibrationError e = ComputeCalibrationError(report.after, outcome->reference_state);
-      std::fprintf(stderr, "\rcalibrate: frame %d/%d  %s %.3f deg, %.3f m, dt %+.1f ms  gray %.2f  health %.2f   ",
-                   i - first + 1, last - first + 1, outcome->has_truth ? "error" : "vs drive calib",
-                   e.rotation_deg, e.translation_norm_m, 1000 * report.after.time_offset_s,
-                   report.gray_rate_after, report.health);
+      std::fprintf(
+          stderr,
+          "\rcalibrate: frame %d/%d  %s %.3f deg, %.3f m, dt %+.1f ms  gray %.2f  health %.2f   ",
+          i - first + 1, last - first + 1, outcome->has_truth ? "error" : "vs drive calib",
+          e.rotation_deg, e.translation_norm_m, 1000 * report.after.time_offset_s,
+          report.gray_rate_after, report.health);
     }
   }
   if (job.progress) std::fprintf(stderr, "\n");
@@ -233,8 +250,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   double settle_deg = 0;
   for (size_t k = outcome->reports.size() >= 3 ? outcome->reports.size() - 3 : 0;
        k < outcome->reports.size(); ++k) {
-    settle_deg = std::max(settle_deg, RotationErrorDeg(outcome->reports[k].after.T_camera_lidar.linear(),
-                                                       outcome->estimate.T_camera_lidar.linear()));
+    settle_deg =
+        std::max(settle_deg, RotationErrorDeg(outcome->reports[k].after.T_camera_lidar.linear(),
+                                              outcome->estimate.T_camera_lidar.linear()));
   }
   const int points = final_report.points;
   if (points < 30) {
@@ -269,7 +287,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   }
   nlohmann::json std_json, observable_json;
   for (int k = 0; k < kNumAxes; ++k) {
-    std_json[kAxisNames[k]] = refine.covariance_ok ? nlohmann::json(refine.std_dev[k]) : nlohmann::json(nullptr);
+    std_json[kAxisNames[k]] =
+        refine.covariance_ok ? nlohmann::json(refine.std_dev[k]) : nlohmann::json(nullptr);
     observable_json[kAxisNames[k]] = refine.observable[k];
   }
   const Eigen::Vector3d rpy_deg = EulerRpyDeg(outcome->estimate.T_camera_lidar.linear());
@@ -295,9 +314,12 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"health", final_report.health},
       {"frames", {{"first", first}, {"last", last}}},
       {"timing_ms",
-       {{"per_frame_mean", outcome->mean_frame_ms}, {"search_mean", search_ms},
+       {{"per_frame_mean", outcome->mean_frame_ms},
+        {"search_mean", search_ms},
         {"refine_mean", refine_ms},
-        {"total", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run_start).count()}}},
+        {"total",
+         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run_start)
+             .count()}}},
       {"reference", outcome->reference},
       {"initial_error", ErrorJson(outcome->initial_error)},
   };
@@ -311,20 +333,22 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
 
   std::string csv =
       "frame,accepted,coarse_search,points,gray_rate,health,roll_deg,pitch_deg,yaw_deg,x_m,y_m,z_m,"
-      "time_offset_s,rotation_error_deg,translation_error_m,time_offset_error_s,search_ms,refine_ms,"
+      "time_offset_s,rotation_error_deg,translation_error_m,time_offset_error_s,search_ms,refine_"
+      "ms,"
       "reason\n";
   std::vector<double> xs, rot_err, trans_err_cm, dt_ms, roll_e, pitch_e, yaw_e;
   for (const FrameReport& r : outcome->reports) {
     const CalibrationError e = ComputeCalibrationError(r.after, outcome->reference_state);
     const Eigen::Vector3d rpy = EulerRpyDeg(r.after.T_camera_lidar.linear());
     char row[512];
-    std::snprintf(row, sizeof(row),
-                  "%d,%d,%d,%d,%.4f,%.4f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.6f,%.5f,%.5f,%.6f,%.2f,%.2f,",
-                  r.frame, r.accepted, r.coarse_search, r.points, r.gray_rate_after, r.health,
-                  rpy.x(), rpy.y(), rpy.z(), r.after.T_camera_lidar.translation().x(),
-                  r.after.T_camera_lidar.translation().y(), r.after.T_camera_lidar.translation().z(),
-                  r.after.time_offset_s, e.rotation_deg, e.translation_norm_m, e.time_offset_s,
-                  r.search_ms, r.refine_ms);
+    std::snprintf(
+        row, sizeof(row),
+        "%d,%d,%d,%d,%.4f,%.4f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.6f,%.5f,%.5f,%.6f,%.2f,%.2f,",
+        r.frame, r.accepted, r.coarse_search, r.points, r.gray_rate_after, r.health, rpy.x(),
+        rpy.y(), rpy.z(), r.after.T_camera_lidar.translation().x(),
+        r.after.T_camera_lidar.translation().y(), r.after.T_camera_lidar.translation().z(),
+        r.after.time_offset_s, e.rotation_deg, e.translation_norm_m, e.time_offset_s, r.search_ms,
+        r.refine_ms);
     csv += row + Csv(r.reason) + "\n";
     xs.push_back(r.frame);
     rot_err.push_back(e.rotation_deg);
@@ -337,15 +361,23 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   status = WriteTextFile(out + "/per_frame.csv", csv);
   if (!status.ok()) return fail(status);
 
-  const std::string vs = outcome->has_truth ? "error vs ground truth" : "difference from the drive calibration";
+  const std::string vs =
+      outcome->has_truth ? "error vs ground truth" : "difference from the drive calibration";
   std::vector<cv::Mat> panels = {
       PlotPanel("rotation " + vs + " [deg]", xs,
-                {{"total", rot_err, cv::Scalar(0, 0, 0)}, {"roll", roll_e, cv::Scalar(0, 0, 220)},
-                 {"pitch", pitch_e, cv::Scalar(0, 160, 0)}, {"yaw", yaw_e, cv::Scalar(220, 0, 0)}}),
-      PlotPanel("translation " + vs + " [cm]", xs, {{"|t|", trans_err_cm, cv::Scalar(120, 0, 120)}}),
+                {{"total", rot_err, cv::Scalar(0, 0, 0)},
+                 {"roll", roll_e, cv::Scalar(0, 0, 220)},
+                 {"pitch", pitch_e, cv::Scalar(0, 160, 0)},
+                 {"yaw", yaw_e, cv::Scalar(220, 0, 0)}}),
+      PlotPanel("translation " + vs + " [cm]", xs,
+                {{"|t|", trans_err_cm, cv::Scalar(120, 0, 120)}}),
       PlotPanel("time offset estimate [ms]" +
-                    (outcome->has_truth ? " (truth " + std::to_string(1000 * outcome->reference_state.time_offset_s).substr(0, 6) + ")"
-                                        : std::string()),
+                    (outcome->has_truth
+                         ? " (truth " +
+                               std::to_string(1000 * outcome->reference_state.time_offset_s)
+                                   .substr(0, 6) +
+                               ")"
+                         : std::string()),
                 xs, {{"delta", dt_ms, cv::Scalar(0, 120, 200)}})};
   cv::Mat convergence;
   cv::vconcat(panels, convergence);
@@ -353,8 +385,10 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   status = drive.LoadImage(last_frame->index, &image);
   if (!status.ok()) return fail(status);
   for (const auto& [name, picture] : std::vector<std::pair<std::string, cv::Mat>>{
-           {"overlay_before.png", DrawEdgeOverlay(image, *last_frame, outcome->initial, "before: initial calibration")},
-           {"overlay_after.png", DrawEdgeOverlay(image, *last_frame, outcome->estimate, "after: estimate")},
+           {"overlay_before.png",
+            DrawEdgeOverlay(image, *last_frame, outcome->initial, "before: initial calibration")},
+           {"overlay_after.png",
+            DrawEdgeOverlay(image, *last_frame, outcome->estimate, "after: estimate")},
            {"convergence.png", convergence}}) {
     status = WriteImage(out + "/" + name, picture);
     if (!status.ok()) return fail(status);
@@ -377,11 +411,12 @@ int RunCalibrate() {
   const CalibrationError& e = outcome.error;
   std::printf("%s after %zu frames (%s)\n", outcome.converged ? "converged" : "NOT converged",
               outcome.reports.size(), outcome.reason.c_str());
-  std::printf("%s: rotation %.3f deg (roll %+.3f, pitch %+.3f, yaw %+.3f), translation %.3f m, "
-              "time offset %+.2f ms (estimate %+.2f ms)\n",
-              outcome.has_truth ? "error vs ground truth" : "agreement with the drive calibration",
-              e.rotation_deg, e.roll_deg, e.pitch_deg, e.yaw_deg, e.translation_norm_m,
-              1000 * e.time_offset_s, 1000 * outcome.estimate.time_offset_s);
+  std::printf(
+      "%s: rotation %.3f deg (roll %+.3f, pitch %+.3f, yaw %+.3f), translation %.3f m, "
+      "time offset %+.2f ms (estimate %+.2f ms)\n",
+      outcome.has_truth ? "error vs ground truth" : "agreement with the drive calibration",
+      e.rotation_deg, e.roll_deg, e.pitch_deg, e.yaw_deg, e.translation_norm_m,
+      1000 * e.time_offset_s, 1000 * outcome.estimate.time_offset_s);
   std::printf("mean %.1f ms per frame; outputs in %s\n", outcome.mean_frame_ms, FLAGS_out.c_str());
   return code;
 }

@@ -1,10 +1,11 @@
 // stcalib demo: simulate a drive with a known extrinsic and time offset, calibrate it from a
 // wrong start, and print truth, start, estimate and error side by side.
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <random>
-#include <unistd.h>
 
 #include "apps/calibrate_job.h"
 #include "apps/commands.h"
@@ -17,17 +18,19 @@ int RunDemo() {
   namespace fs = std::filesystem;
   const auto start = std::chrono::steady_clock::now();
   std::error_code ec;
-  const std::string root = FLAGS_out.empty()
-                               ? (fs::temp_directory_path() / ("stcalib_demo_" + std::to_string(::getpid()))).string()
-                               : FLAGS_out;
+  const std::string root =
+      FLAGS_out.empty()
+          ? (fs::temp_directory_path() / ("stcalib_demo_" + std::to_string(::getpid()))).string()
+          : FLAGS_out;
   fs::create_directories(root, ec);
   sim::SimulatorOptions sim_options;
   sim_options.frames = FLAGS_frames > 0 && FLAGS_frames != 40 ? FLAGS_frames : 20;
   sim_options.seed = FLAGS_seed;
   sim_options.time_offset_s = 0.03;
   sim_options.dynamic_objects = 6;
-  std::printf("1/2 simulating %d frames (seed %llu, true time offset +30 ms, 6 moving objects) in %s\n",
-              sim_options.frames, static_cast<unsigned long long>(sim_options.seed), root.c_str());
+  std::printf(
+      "1/2 simulating %d frames (seed %llu, true time offset +30 ms, 6 moving objects) in %s\n",
+      sim_options.frames, static_cast<unsigned long long>(sim_options.seed), root.c_str());
   std::fflush(stdout);
   std::string drive_dir;
   Status status = sim::WriteSimulatedDrive(sim_options, root + "/sim", &drive_dir);
@@ -51,11 +54,13 @@ int RunDemo() {
   if (outcome.reports.empty()) return code;
 
   auto row = [](const char* name, const CalibrationError& e, double delta_ms) {
-    std::printf("  %-9s %8.3f %8.3f %8.3f %8.3f | %7.1f %7.1f %7.1f | %8.2f\n", name, e.rotation_deg,
-                e.roll_deg, e.pitch_deg, e.yaw_deg, 100 * e.translation_m.x(),
+    std::printf("  %-9s %8.3f %8.3f %8.3f %8.3f | %7.1f %7.1f %7.1f | %8.2f\n", name,
+                e.rotation_deg, e.roll_deg, e.pitch_deg, e.yaw_deg, 100 * e.translation_m.x(),
                 100 * e.translation_m.y(), 100 * e.translation_m.z(), delta_ms);
   };
-  std::printf("\n            rotation error [deg]                 | translation error [cm] | time offset [ms]\n");
+  std::printf(
+      "\n            rotation error [deg]                 | translation error [cm] | time offset "
+      "[ms]\n");
   std::printf("            total     roll    pitch      yaw |       x       y       z |\n");
   row("truth", CalibrationError(), 1000 * outcome.reference_state.time_offset_s);
   row("start", outcome.initial_error, 1000 * outcome.initial.time_offset_s);

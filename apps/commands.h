@@ -18,6 +18,7 @@ int RunSimulate();
 int RunFeatures();
 int RunCalibrate();
 int RunDemo();
+int RunEvalTemporal();
 
 // Prints "stcalib <command>: error: <message>" to stderr and returns kExitFailure.
 int ReportError(const std::string& command, const Status& status);

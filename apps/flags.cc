@@ -19,7 +19,8 @@ DEFINE_double(max_edge_density, 0.0,
               "features: drop edge pixels in windows denser than this share (texture), 0 = off");
 // calibrate
 DEFINE_string(init_calib, "", "calibrate: initial calib_velo_to_cam.txt (default: the drive's)");
-DEFINE_double(perturb_rot_deg, 0.0, "calibrate: add this roll/pitch/yaw error (random signs) [deg]");
+DEFINE_double(perturb_rot_deg, 0.0,
+              "calibrate: add this roll/pitch/yaw error (random signs) [deg]");
 DEFINE_double(perturb_trans_m, 0.0, "calibrate: add this x/y/z error (random signs) [m]");
 DEFINE_double(perturb_time_s, 0.0, "calibrate: initial time offset δ0 [s]");
 DEFINE_int32(first_frame, 0, "calibrate: first frame used");
@@ -38,12 +39,22 @@ DEFINE_double(gamma, 0.45, "search: gray-rate threshold between the large and th
 DEFINE_double(lost_health, 0.9, "calibrate: below this health the search goes coarse-to-fine");
 DEFINE_double(prior_sigma_rotation_deg, 2.0, "refine: weak rotation prior [deg]");
 DEFINE_double(prior_sigma_translation_m, 0.05, "refine: translation prior [m]");
-DEFINE_double(observable_rotation_deg, 0.15, "refine: a rotation axis is observable below this std [deg]");
-DEFINE_double(observable_translation_m, 0.04, "refine: a translation axis is observable below this std [m]");
+DEFINE_double(observable_rotation_deg, 0.15,
+              "refine: a rotation axis is observable below this std [deg]");
+DEFINE_double(observable_translation_m, 0.04,
+              "refine: a translation axis is observable below this std [m]");
 DEFINE_double(observable_time_s, 0.006, "refine: δ is observable below this std [s]");
 DEFINE_int32(local_map_sweeps, 3, "calibrate: sweeps merged into the local map");
 DEFINE_bool(use_ndt, false, "calibrate: refine the local map's poses with PCL NDT");
 DEFINE_bool(suppress_texture, false, "calibrate: score on texture-suppressed maps");
-DEFINE_bool(oriented_maps, true, "calibrate: vertical/horizontal LiDAR edges read maps of vertical/horizontal image edges");
-DEFINE_int32(disturb_frame, -1, "calibrate: at this frame add a rotation disturbance (test protocol)");
-DEFINE_double(disturb_rot_deg, 2.0, "calibrate: size of that disturbance on roll, pitch and yaw [deg]");
+DEFINE_bool(
+    oriented_maps, true,
+    "calibrate: vertical/horizontal LiDAR edges read maps of vertical/horizontal image edges");
+DEFINE_int32(disturb_frame, -1,
+             "calibrate: at this frame add a rotation disturbance (test protocol)");
+DEFINE_double(disturb_rot_deg, 2.0,
+              "calibrate: size of that disturbance on roll, pitch and yaw [deg]");
+// eval-temporal
+DEFINE_int32(lidar_decimation, 2, "eval-temporal: keep every n-th sweep");
+DEFINE_double(lidar_delay_s, 0.1, "eval-temporal: the kept sweeps arrive this late [s]");
+DEFINE_double(eval_max_range_m, 40.0, "eval-temporal: points beyond this range are left out [m]");

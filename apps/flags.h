@@ -46,3 +46,6 @@ DECLARE_bool(suppress_texture);
 DECLARE_int32(disturb_frame);
 DECLARE_double(disturb_rot_deg);
 DECLARE_bool(oriented_maps);
+DECLARE_int32(lidar_decimation);
+DECLARE_double(lidar_delay_s);
+DECLARE_double(eval_max_range_m);

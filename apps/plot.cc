@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-
 #include <opencv2/imgproc.hpp>
 
 namespace stcalib::cli {
@@ -24,10 +23,12 @@ cv::Mat PlotPanel(const std::string& title, const std::vector<double>& x,
   const double pad = 0.05 * (y_max - y_min);
   y_min -= pad;
   y_max += pad;
-  const double x_min = x.empty() ? 0 : x.front(), x_max = x.empty() ? 1 : std::max(x.back(), x_min + 1);
+  const double x_min = x.empty() ? 0 : x.front(),
+               x_max = x.empty() ? 1 : std::max(x.back(), x_min + 1);
   auto px = [&](double xv, double yv) {
-    return cv::Point(left + static_cast<int>((xv - x_min) / (x_max - x_min) * (width - left - right)),
-                     top + static_cast<int>((y_max - yv) / (y_max - y_min) * (height - top - bottom)));
+    return cv::Point(
+        left + static_cast<int>((xv - x_min) / (x_max - x_min) * (width - left - right)),
+        top + static_cast<int>((y_max - yv) / (y_max - y_min) * (height - top - bottom)));
   };
   cv::rectangle(canvas, cv::Point(left, top), cv::Point(width - right, height - bottom),
                 cv::Scalar(0, 0, 0), 1);

@@ -42,6 +42,11 @@ const std::vector<Subcommand>& Subcommands() {
        "online calibration of rotation, translation and time offset; writes the estimate, "
        "result.json, per_frame.csv and pictures; exit 0 only when converged",
        &RunCalibrate},
+      {"eval-temporal",
+       "--drive=DRIVE_DIR [--lidar_decimation=2] [--lidar_delay_s=0.1] [--out=DIR]",
+       "the paper's Table I: ApproximateTime pairing vs the motion model (filter_cloud, "
+       "infer_cloud, infer_cloud_interpolation)",
+       &RunEvalTemporal},
       {"demo", "[--out=DIR] [--seed=S]",
        "simulate a drive (true time offset +30 ms), calibrate it from +-2 deg / +-5 cm, print "
        "truth, start, estimate and error",

@@ -57,8 +57,8 @@ void BM_ProjectFrame(benchmark::State& state) {
   if (!OpenKitti(state, &drive)) return;
   LidarScan scan;
   if (!drive.LoadScan(0, &scan).ok()) return state.SkipWithError("cannot read scan");
-  const CameraModel camera = MakeCameraModel(drive.camera, drive.camera.image_width,
-                                                          drive.camera.image_height);
+  const CameraModel camera =
+      MakeCameraModel(drive.camera, drive.camera.image_width, drive.camera.image_height);
   for (auto _ : state) {
     benchmark::DoNotOptimize(ProjectPoints(camera, drive.T_camera_lidar, scan.points_lidar));
   }

@@ -21,8 +21,8 @@ namespace stcalib {
 class CalibrationPriorCost {
  public:
   CalibrationPriorCost(const Eigen::Quaterniond& q0, const Eigen::Vector3d& t0, double delta0_s,
-                       double sigma_rotation_rad, const Eigen::Matrix3d& sqrt_information_translation,
-                       double sigma_time_s)
+                       double sigma_rotation_rad,
+                       const Eigen::Matrix3d& sqrt_information_translation, double sigma_time_s)
       : q0_inverse_(q0.conjugate().normalized()),
         t0_(t0),
         delta0_s_(delta0_s),

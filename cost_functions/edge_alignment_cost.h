@@ -54,8 +54,7 @@ class EdgeAlignmentCost {
     const Eigen::Quaternion<T> q = Eigen::Map<const Eigen::Quaternion<T>>(pose).normalized();
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t(pose + 4);
     const T e = T(e0_s_) + time_offset[0];
-    const Eigen::Matrix<T, 3, 1> p_moved =
-        ApplyLidarMotion<T>(twist_, e, point_lidar_.cast<T>());
+    const Eigen::Matrix<T, 3, 1> p_moved = ApplyLidarMotion<T>(twist_, e, point_lidar_.cast<T>());
     const Eigen::Matrix<T, 3, 1> p_camera = q * p_moved + t;
     Eigen::Matrix<T, 2, 1> pixel;
     T depth;
@@ -73,8 +72,8 @@ class EdgeAlignmentCost {
                                      const LidarTwist& twist, double e0_s,
                                      const CameraModel* camera, const DistanceInterpolator* map,
                                      double outside_px) {
-    return new ceres::AutoDiffCostFunction<EdgeAlignmentCost, 1, 7, 1>(new EdgeAlignmentCost(
-        point_lidar, weight, twist, e0_s, camera, map, outside_px));
+    return new ceres::AutoDiffCostFunction<EdgeAlignmentCost, 1, 7, 1>(
+        new EdgeAlignmentCost(point_lidar, weight, twist, e0_s, camera, map, outside_px));
   }
 
  private:

@@ -1,10 +1,10 @@
 // Calibration on a simulated drive with exact truth: search, refinement, health, time-offset
 // profile and the online calibrator (issue 5). One drive is simulated once and every stage is
 // checked on it, so this stays a few seconds long.
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <memory>
-
-#include <gtest/gtest.h>
 
 #include "core/online/frame_source.h"
 #include "core/online/online_calibrator.h"
@@ -55,7 +55,8 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   // Search: coarse-to-fine from 2° on every axis comes back within 1°.
   const CalibrationState start =
       Step(truth, Eigen::Vector3d(2, -2, 2) * M_PI / 180.0, Eigen::Vector3d::Zero(), -0.03);
-  const SearchResult search = AdaptiveGridSearch(&scorer, start, start, AdaptiveGridSearchOptions());
+  const SearchResult search =
+      AdaptiveGridSearch(&scorer, start, start, AdaptiveGridSearchOptions());
   const CalibrationError search_error = ComputeCalibrationError(search.state, truth);
   std::printf("search from %.2f deg: %s (%d evaluations)\n",
               ComputeCalibrationError(start, truth).rotation_deg, ToString(search_error).c_str(),

@@ -156,7 +156,22 @@ TEST(Cli, CalibrateWithoutFeaturesFailsAndClaimsNothing) {
   EXPECT_THAT(text.str(), HasSubstr("\"converged\": false"));
   EXPECT_EQ(RunStcalib("calibrate --drive=" + drive + " --out=" + out + " --loss=l3").exit_code, 2);
   EXPECT_EQ(RunStcalib("calibrate --drive=" + drive).exit_code, 2);  // no --out
-  EXPECT_EQ(RunStcalib("calibrate --drive=" + drive + " --out=" + out + " --num_frames=50").exit_code, 1);
+  EXPECT_EQ(
+      RunStcalib("calibrate --drive=" + drive + " --out=" + out + " --num_frames=50").exit_code, 1);
+}
+
+TEST(Cli, EvalTemporalBadInput) {
+  testing::ScopedTempDir tmp;
+  const std::string drive = testing::MakeTinyDrive(tmp.path(), 3);
+  const RunResult short_drive =
+      RunStcalib("eval-temporal --drive=" + drive + " --out=" + tmp.path() + "/e");
+  EXPECT_EQ(short_drive.exit_code, 1);
+  EXPECT_THAT(short_drive.output, HasSubstr("too few for a decimation of 2"));
+  EXPECT_EQ(RunStcalib("eval-temporal --drive=" + drive).exit_code, 2);
+  EXPECT_EQ(RunStcalib("eval-temporal --drive=" + drive + " --out=" + tmp.path() +
+                       "/e --lidar_decimation=0")
+                .exit_code,
+            2);
 }
 
 TEST(Cli, SimulateRejectsBadFlags) {

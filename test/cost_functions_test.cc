@@ -1,12 +1,12 @@
 // Motion model Tv(δ), the edge-alignment residual and the prior: nominal values computed by hand
 // and Jacobians checked against numeric differentiation (ceres::GradientChecker).
-#include <cmath>
-#include <random>
-#include <vector>
-
 #include <ceres/manifold.h>
 #include <ceres/product_manifold.h>
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
 
 #include "core/types/calibration.h"
 #include "cost_functions/calibration_prior_cost.h"
@@ -28,7 +28,8 @@ TEST(MotionModel, PureTranslationAndPureRotation) {
   LidarTwist twist;
   twist.linear_m_s = Eigen::Vector3d(12, -0.5, 0.1);
   const Eigen::Vector3d p(10, 2, -1);
-  EXPECT_LT((ApplyLidarMotion<double>(twist, 0.03, p) - (p + 0.03 * twist.linear_m_s)).norm(), 1e-12);
+  EXPECT_LT((ApplyLidarMotion<double>(twist, 0.03, p) - (p + 0.03 * twist.linear_m_s)).norm(),
+            1e-12);
   twist = LidarTwist();
   twist.angular_rad_s = Eigen::Vector3d(0, 0, 0.4);
   const Eigen::Vector3d expected = Eigen::AngleAxisd(0.4 * 0.05, Eigen::Vector3d::UnitZ()) * p;
@@ -65,7 +66,8 @@ TEST(MotionModel, GroupPropertyAndLogRoundTrip) {
 // differently for double and for Jet — a 1e-15 difference that makes it reject both functors
 // and print meaningless numeric Jacobians.)
 double WorstTangentJacobianError(const ceres::CostFunction& cost, double* pose, double* delta) {
-  const ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> manifold;
+  const ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>
+      manifold;
   const int n = cost.num_residuals();
   std::vector<double> residual(n), j_pose(n * 7), j_delta(n);
   double* jacobians[2] = {j_pose.data(), j_delta.data()};
@@ -123,7 +125,8 @@ struct SyntheticMap {
 CameraModel TestCamera() {
   CameraModel camera;
   camera.P_rect_02 << 700, 0, 600, 45, 0, 700, 180, 0.2, 0, 0, 1, 0.003;
-  camera.R_rect_00 = Eigen::AngleAxisd(0.01, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  camera.R_rect_00 =
+      Eigen::AngleAxisd(0.01, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   camera.width = 1200;
   camera.height = 360;
   return camera;
@@ -172,8 +175,8 @@ TEST(EdgeAlignmentCost, JacobiansMatchNumericDifferentiation) {
                                           Eigen::Vector3d(unit(rng), unit(rng), unit(rng)),
                                           0.05 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng)));
     const Eigen::Quaterniond q(T.linear());
-    double pose[7] = {q.x(), q.y(), q.z(), q.w(), T.translation().x(), T.translation().y(),
-                      T.translation().z()};
+    double pose[7] = {
+        q.x(), q.y(), q.z(), q.w(), T.translation().x(), T.translation().y(), T.translation().z()};
     double delta = 0.05 * unit(rng);
     std::unique_ptr<ceres::CostFunction> cost(EdgeAlignmentCost::Create(
         p, 0.7, twist, 0.02 * unit(rng), &camera, map.interpolator.get(), 20.0));
@@ -198,7 +201,8 @@ TEST(CalibrationPriorCost, NominalValuesAndJacobians) {
       CalibrationPriorCost::Create(q0, t0, 0.01, sigma_r, sigma_t, sigma_d));
   // The reference rotated by 0.02 rad about the LiDAR-side z axis, t moved by (0.05, 0, 0),
   // δ = 0.013: residuals (0, 0, 2 sin(0.01)/σ_r, 1, 0, 0, 1.5).
-  const Eigen::Quaterniond q = q0 * Eigen::Quaterniond(Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitZ()));
+  const Eigen::Quaterniond q =
+      q0 * Eigen::Quaterniond(Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitZ()));
   double pose[7] = {q.x(), q.y(), q.z(), q.w(), t0.x() + 0.05, t0.y(), t0.z()};
   double delta = 0.013;
   const double* params[2] = {pose, &delta};

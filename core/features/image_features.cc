@@ -207,7 +207,8 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
   cv::min(distance, options.basin_px, features.distance_px);
   Smooth(&features.distance_px, options.smoothing_sigma_px);
   if (options.split_orientation) {
-    const cv::Mat* raw[2] = {&features.distance_vertical_raw_px, &features.distance_horizontal_raw_px};
+    const cv::Mat* raw[2] = {&features.distance_vertical_raw_px,
+                             &features.distance_horizontal_raw_px};
     for (int o = 0; o < 2; ++o) {
       OrientedMaps& m = features.oriented[o];
       m.idt = InverseDistanceTransform(*raw[o], options.basin_px, options.smoothing_sigma_px);
@@ -215,8 +216,8 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
       cv::min(*raw[o], options.basin_px, m.distance_px);
       Smooth(&m.distance_px, options.smoothing_sigma_px);
       for (double basin : options.pyramid_basins_px) {
-        cv::Mat level =
-            InverseDistanceTransform(*raw[o], basin, std::max(options.smoothing_sigma_px, basin / 10));
+        cv::Mat level = InverseDistanceTransform(*raw[o], basin,
+                                                 std::max(options.smoothing_sigma_px, basin / 10));
         if (options.suppress_pyramid) {
           level = SuppressTexture(level, std::max(options.suppression_sigma_px, 2 * basin));
         }

@@ -1,7 +1,7 @@
 #pragma once
 
-#include <opencv2/core.hpp>
 #include <array>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -47,9 +47,9 @@ struct ImageFeatureOptions {
 
 // The maps of one edge orientation (near-vertical or near-horizontal image edges).
 struct OrientedMaps {
-  cv::Mat idt;                  ///< CV_32F, smoothed IDT in [0, 255]
-  cv::Mat idt_suppressed;       ///< texture-suppressed IDT
-  cv::Mat distance_px;          ///< smoothed min(D, basin) [px]
+  cv::Mat idt;                   ///< CV_32F, smoothed IDT in [0, 255]
+  cv::Mat idt_suppressed;        ///< texture-suppressed IDT
+  cv::Mat distance_px;           ///< smoothed min(D, basin) [px]
   std::vector<cv::Mat> pyramid;  ///< IDTs at pyramid_basins_px (suppressed if asked)
 };
 
@@ -65,7 +65,7 @@ struct ImageFeatures {
   std::vector<cv::Vec4f> segments;   ///< line segments at full-size coordinates (LSD/FLD)
   // With split_orientation: the maps of near-vertical [0] and near-horizontal [1] edges.
   std::array<OrientedMaps, 2> oriented;
-  int edge_pixels = 0;               ///< after texture suppression
+  int edge_pixels = 0;  ///< after texture suppression
   int dense_pixels_removed = 0;
 
   bool empty() const { return edge_pixels == 0; }

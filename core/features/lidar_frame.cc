@@ -113,7 +113,8 @@ Status SweepCache::References(size_t frame, std::vector<ReferenceFeatures>* refe
                 (drive_.NumFrames() - 1)
           : 0.1;
   const size_t back = std::max<size_t>(
-      1, static_cast<size_t>(std::lround(options_.dynamic.long_baseline_s / std::max(period, 1e-3))));
+      1,
+      static_cast<size_t>(std::lround(options_.dynamic.long_baseline_s / std::max(period, 1e-3))));
   const LidarFrameFeatures* current;
   STCALIB_RETURN_IF_ERROR(Base(frame, &current));
   for (size_t gap : {size_t{1}, back}) {

@@ -25,8 +25,8 @@ Rigid3d LidarMotion(const LidarTwist& twist, double e_s) {
   Rigid3d T = Rigid3d::Identity();
   T.translation() = ApplyLidarMotion<double>(twist, e_s, Eigen::Vector3d::Zero());
   for (int k = 0; k < 3; ++k) {
-    T.linear().col(k) = ApplyLidarMotion<double>(twist, e_s, Eigen::Vector3d::Unit(k)) -
-                        T.translation();
+    T.linear().col(k) =
+        ApplyLidarMotion<double>(twist, e_s, Eigen::Vector3d::Unit(k)) - T.translation();
   }
   return T;
 }

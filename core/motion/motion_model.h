@@ -1,9 +1,8 @@
 #pragma once
 
-#include <cmath>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 
 #include "core/motion/deskew.h"
 #include "core/types/transform.h"

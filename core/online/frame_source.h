@@ -34,7 +34,8 @@ class DriveFrameSource {
   const DriveMotion& motion() const { return motion_; }
 
  private:
-  DriveFrameSource(const Drive* drive, const FrameSourceOptions& options) : drive_(drive), options_(options) {}
+  DriveFrameSource(const Drive* drive, const FrameSourceOptions& options)
+      : drive_(drive), options_(options) {}
   const Drive* drive_;
   FrameSourceOptions options_;
   DriveMotion motion_;

@@ -1,15 +1,16 @@
 #include "core/online/online_calibrator.h"
 
+#include <glog/logging.h>
+
 #include <chrono>
 #include <cmath>
-
-#include <glog/logging.h>
 
 namespace stcalib {
 namespace {
 
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
 // Keeps the observable axes of `candidate` and the old values of the others.
@@ -24,8 +25,7 @@ CalibrationState KeepObservableAxes(const CalibrationState& old, const Calibrati
     if (observable[k]) r[k] = rotation[k];
     if (observable[3 + k]) t[k] = translation[k];
   }
-  return Step(old, r, t,
-              observable[6] ? candidate.time_offset_s - old.time_offset_s : 0.0);
+  return Step(old, r, t, observable[6] ? candidate.time_offset_s - old.time_offset_s : 0.0);
 }
 
 }  // namespace
@@ -42,8 +42,8 @@ OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
   CHECK(options_.Validate().ok()) << options_.Validate().message();
   options_.search.time_offset_bound_s = options_.time_offset_bound_s;
   options_.refine.time_offset_bound_s = options_.time_offset_bound_s;
-  state_.time_offset_s = std::clamp(state_.time_offset_s, -options_.time_offset_bound_s,
-                                    options_.time_offset_bound_s);
+  state_.time_offset_s =
+      std::clamp(state_.time_offset_s, -options_.time_offset_bound_s, options_.time_offset_bound_s);
   anchor_ = state_;
 }
 
@@ -86,7 +86,8 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   report.frame = frame->index;
   report.before = state_;
   window_.push_back(Prune(frame));
-  while (static_cast<int>(window_.size()) > std::max(options_.window_frames, options_.refine_frames)) {
+  while (static_cast<int>(window_.size()) >
+         std::max(options_.window_frames, options_.refine_frames)) {
     window_.pop_front();
   }
   const std::vector<const CalibrationFrame*> frames = SearchWindow();
@@ -131,8 +132,8 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   const double before_long = long_scorer.Evaluate(state_, -1).score;
   std::vector<std::pair<CalibrationState, std::string>> candidates;
   if (report.refine.usable) {
-    candidates.emplace_back(KeepObservableAxes(state_, report.refine.state, report.refine.observable),
-                            "refined");
+    candidates.emplace_back(
+        KeepObservableAxes(state_, report.refine.state, report.refine.observable), "refined");
   }
   candidates.emplace_back(report.search.state, "search");
   report.after = state_;
@@ -157,10 +158,10 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   if (report.accepted && !report.coarse_search && options_.tracking_gain < 1.0) {
     const CalibrationState& c = report.after;
     const double g = options_.tracking_gain;
-    report.after = Step(state_,
-                        g * LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear()),
-                        g * (c.T_camera_lidar.translation() - state_.T_camera_lidar.translation()),
-                        g * (c.time_offset_s - state_.time_offset_s));
+    report.after = Step(
+        state_, g * LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear()),
+        g * (c.T_camera_lidar.translation() - state_.T_camera_lidar.translation()),
+        g * (c.time_offset_s - state_.time_offset_s));
   }
   report.score_after = scorer.Evaluate(report.after, -1);
   state_ = report.after;

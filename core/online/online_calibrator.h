@@ -14,8 +14,8 @@
 namespace stcalib {
 
 struct OnlineCalibratorOptions {
-  int window_frames = 3;              ///< sliding window of frames searched together
-  int refine_frames = 10;             ///< the refinement uses this many latest frames
+  int window_frames = 3;   ///< sliding window of frames searched together
+  int refine_frames = 10;  ///< the refinement uses this many latest frames
   ScoreOptions score;
   AdaptiveGridSearchOptions search;
   RefineOptions refine;
@@ -38,11 +38,11 @@ struct FrameReport {
   int frame = 0;
   CalibrationState before, after;
   bool accepted = false;
-  std::string reason;        ///< why the update was (not) taken
-  ScoreValue score_before, score_after;  ///< on the finest score map
+  std::string reason;                                ///< why the update was (not) taken
+  ScoreValue score_before, score_after;              ///< on the finest score map
   double gray_rate_before = 0, gray_rate_after = 0;  ///< on the plain IDT
-  double health_before = 0;  ///< method.md §7, at `before`
-  double health = 0;         ///< method.md §7, at `after`
+  double health_before = 0;                          ///< method.md §7, at `before`
+  double health = 0;                                 ///< method.md §7, at `after`
   bool coarse_search = false;
   SearchResult search;
   RefineResult refine;
@@ -66,7 +66,8 @@ class OnlineCalibrator {
   std::vector<const CalibrationFrame*> SearchWindow() const;
 
  private:
-  std::shared_ptr<const CalibrationFrame> Prune(std::shared_ptr<const CalibrationFrame> frame) const;
+  std::shared_ptr<const CalibrationFrame> Prune(
+      std::shared_ptr<const CalibrationFrame> frame) const;
 
   OnlineCalibratorOptions options_;
   CalibrationState state_;

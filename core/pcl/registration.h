@@ -13,7 +13,7 @@ namespace stcalib {
 struct NdtOptions {
   double resolution_m = 1.0;  ///< NDT cell size [m]
   double step_size_m = 0.1;   ///< More–Thuente maximum step [m]
-  double epsilon = 0.01;      ///< transformation change that ends the iterations
+  double epsilon = 1e-6;      ///< PCL transformation epsilon (compared with a squared step)
   int max_iterations = 35;
   double voxel_m = 0.4;  ///< both clouds are voxel-downsampled first [m]; 0 = no
 };

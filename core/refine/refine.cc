@@ -1,11 +1,11 @@
 #include "core/refine/refine.h"
 
-#include <cmath>
-#include <memory>
-
 #include <ceres/ceres.h>
 #include <ceres/product_manifold.h>
 #include <glog/logging.h>
+
+#include <cmath>
+#include <memory>
 
 #include "cost_functions/calibration_prior_cost.h"
 #include "cost_functions/edge_alignment_cost.h"
@@ -38,22 +38,27 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
   std::vector<std::unique_ptr<DistanceGrid>> grids;
   std::vector<std::unique_ptr<DistanceInterpolator>> interpolators;
   const Eigen::Quaterniond q_start(start.T_camera_lidar.linear());
-  double pose[7] = {q_start.x(), q_start.y(), q_start.z(), q_start.w(),
-                    start.T_camera_lidar.translation().x(), start.T_camera_lidar.translation().y(),
+  double pose[7] = {q_start.x(),
+                    q_start.y(),
+                    q_start.z(),
+                    q_start.w(),
+                    start.T_camera_lidar.translation().x(),
+                    start.T_camera_lidar.translation().y(),
                     start.T_camera_lidar.translation().z()};
-  double delta = std::clamp(start.time_offset_s, -options.time_offset_bound_s,
-                            options.time_offset_bound_s);
+  double delta =
+      std::clamp(start.time_offset_s, -options.time_offset_bound_s, options.time_offset_bound_s);
   ceres::Problem problem;
-  problem.AddParameterBlock(pose, 7,
-                            new ceres::ProductManifold<ceres::EigenQuaternionManifold,
-                                                       ceres::EuclideanManifold<3>>());
+  problem.AddParameterBlock(
+      pose, 7,
+      new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>());
   problem.AddParameterBlock(&delta, 1);
   ceres::LossFunction* loss =
       options.loss == RefineOptions::Loss::kCauchy
           ? static_cast<ceres::LossFunction*>(new ceres::CauchyLoss(options.loss_scale_px))
           : new ceres::HuberLoss(options.loss_scale_px);
   for (const CalibrationFrame* frame : window) {
-    if (frame->distance_px[0].empty() || frame->distance_px[1].empty() || frame->size() == 0) continue;
+    if (frame->distance_px[0].empty() || frame->distance_px[1].empty() || frame->size() == 0)
+      continue;
     const DistanceInterpolator* by_kind[2];
     double cap = 0;
     for (int kind = 0; kind < 2; ++kind) {
@@ -67,23 +72,23 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
       cap = std::max(cap, max_value);
     }
     const size_t n = frame->size();
-    const size_t keep = options.max_points_per_frame > 0
-                            ? std::min<size_t>(n, options.max_points_per_frame)
-                            : n;
+    const size_t keep =
+        options.max_points_per_frame > 0 ? std::min<size_t>(n, options.max_points_per_frame) : n;
     for (size_t k = 0; k < keep; ++k) {
       const size_t i = k * n / keep;
       const double w = frame->kinds[i] == EdgeKind::kHorizontal ? options.horizontal_weight
                                                                 : 1.0 - options.horizontal_weight;
       if (w <= 0) continue;
-      problem.AddResidualBlock(
-          EdgeAlignmentCost::Create(frame->points_lidar[i], w, frame->twist, frame->e0_s,
-                                    &frame->camera, by_kind[static_cast<int>(frame->kinds[i])], cap),
-          loss, pose, &delta);
+      problem.AddResidualBlock(EdgeAlignmentCost::Create(
+                                   frame->points_lidar[i], w, frame->twist, frame->e0_s,
+                                   &frame->camera, by_kind[static_cast<int>(frame->kinds[i])], cap),
+                               loss, pose, &delta);
       ++result.residuals;
     }
   }
   if (result.residuals < 20) {
-    result.message = "too few LiDAR edge points to refine (" + std::to_string(result.residuals) + ")";
+    result.message =
+        "too few LiDAR edge points to refine (" + std::to_string(result.residuals) + ")";
     return result;
   }
   // Translation prior: weak across the direction of travel, per point along it.
@@ -94,9 +99,9 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
           : Eigen::Vector3d::UnitZ();
   const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - forward * forward.transpose();
   const double n = static_cast<double>(result.residuals);
-  const Eigen::Matrix3d sqrt_information = across / options.prior_sigma_translation_m +
-                                           std::sqrt(n) / options.prior_sigma_forward_m *
-                                               forward * forward.transpose();
+  const Eigen::Matrix3d sqrt_information =
+      across / options.prior_sigma_translation_m +
+      std::sqrt(n) / options.prior_sigma_forward_m * forward * forward.transpose();
   const Eigen::Quaterniond q_prior(rotation_prior.T_camera_lidar.linear());
   problem.AddResidualBlock(
       CalibrationPriorCost::Create(q_prior, mount_prior.T_camera_lidar.translation(),
@@ -144,11 +149,13 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
       const double sigma2 = 2.0 * summary.final_cost / dof;
       // Tangent of EigenQuaternionManifold: q ⊕ δ = [cos|δ|, sin|δ|·δ/|δ|] ⊗ q, a rotation of
       // 2δ on the camera side; about the LiDAR axes that is 2·Rᵀ·δ.
-      Eigen::Matrix<double, kNumAxes, kNumAxes> J = Eigen::Matrix<double, kNumAxes, kNumAxes>::Zero();
+      Eigen::Matrix<double, kNumAxes, kNumAxes> J =
+          Eigen::Matrix<double, kNumAxes, kNumAxes>::Zero();
       J.block<3, 3>(0, 0) = 2.0 * (180.0 / M_PI) * result.state.T_camera_lidar.linear().transpose();
       J.block<3, 3>(3, 3).setIdentity();
       J(6, 6) = 1.0;
-      Eigen::Matrix<double, kNumAxes, kNumAxes> full = Eigen::Matrix<double, kNumAxes, kNumAxes>::Zero();
+      Eigen::Matrix<double, kNumAxes, kNumAxes> full =
+          Eigen::Matrix<double, kNumAxes, kNumAxes>::Zero();
       full.topLeftCorner(n, n) = C * sigma2;
       const Eigen::Matrix<double, kNumAxes, kNumAxes> axes = J * full * J.transpose();
       for (int k = 0; k < kNumAxes; ++k) result.std_dev[k] = std::sqrt(std::max(0.0, axes(k, k)));

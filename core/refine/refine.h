@@ -1,10 +1,9 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "core/score/calibration_frame.h"
 #include "core/types/calibration.h"
@@ -19,8 +18,8 @@ namespace stcalib {
 struct RefineOptions {
   enum class Loss { kHuber, kCauchy };
   Loss loss = Loss::kCauchy;
-  double loss_scale_px = 3.0;            ///< robust-loss scale [px]
-  double horizontal_weight = 0.5;        ///< w of method.md §6
+  double loss_scale_px = 3.0;      ///< robust-loss scale [px]
+  double horizontal_weight = 0.5;  ///< w of method.md §6
   // Weak priors: rotation towards the search result, translation and δ towards the mount (the
   // initial calibration); they hold only what the data leaves free (δ against the forward
   // translation on a straight road, method.md §10).
@@ -29,8 +28,8 @@ struct RefineOptions {
   // Along the direction of travel the translation is held firmly (per point, i.e. the sigma is
   // scaled by √N): there data cannot tell it from δ on a straight road (method.md §10).
   double prior_sigma_forward_m = 0.05;
-  double prior_sigma_time_s = 0.03;         ///< [s]
-  double time_offset_bound_s = 0.15;     ///< |δ| bound [s]
+  double prior_sigma_time_s = 0.03;   ///< [s]
+  double time_offset_bound_s = 0.15;  ///< |δ| bound [s]
   bool estimate_time_offset = true;
   int max_points_per_frame = 800;
   int max_iterations = 30;

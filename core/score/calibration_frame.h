@@ -1,10 +1,9 @@
 #pragma once
 
-#include <array>
-#include <vector>
-
 #include <Eigen/Core>
+#include <array>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "core/features/image_features.h"
 #include "core/features/lidar_edges.h"
@@ -15,13 +14,13 @@ namespace stcalib {
 
 // One image with its LiDAR edge points: everything the score, the search and the refinement read.
 struct CalibrationFrame {
-  int index = 0;         ///< frame of the drive
-  double e0_s = 0;       ///< LiDAR stamp − camera stamp [s]; the gap is e = e0 + δ
-  LidarTwist twist;      ///< LiDAR body twist at the image time (motion model, method.md §3)
-  CameraModel camera;    ///< size read from the image
+  int index = 0;       ///< frame of the drive
+  double e0_s = 0;     ///< LiDAR stamp − camera stamp [s]; the gap is e = e0 + δ
+  LidarTwist twist;    ///< LiDAR body twist at the image time (motion model, method.md §3)
+  CameraModel camera;  ///< size read from the image
   std::vector<Eigen::Vector3d> points_lidar;  ///< edge points (local map), at the LiDAR stamp
   std::vector<EdgeKind> kinds;
-  ImageFeatures image;   ///< distance_raw_px for overlays
+  ImageFeatures image;  ///< distance_raw_px for overlays
   // Maps per edge kind, indexed by EdgeKind (0 vertical, 1 horizontal): with oriented maps a
   // vertical LiDAR edge reads the map of near-vertical image edges only; otherwise both entries
   // share the same map.

@@ -1,9 +1,9 @@
 #include "core/score/score.h"
 
+#include <glog/logging.h>
+
 #include <cmath>
 #include <limits>
-
-#include <glog/logging.h>
 
 namespace stcalib {
 namespace {
@@ -36,9 +36,8 @@ WindowScorer::WindowScorer(std::vector<const CalibrationFrame*> frames, const Sc
     CHECK(f != nullptr);
     std::vector<int> selected;
     const size_t n = f->size();
-    const size_t keep = options.max_points_per_frame > 0
-                            ? std::min<size_t>(n, options.max_points_per_frame)
-                            : n;
+    const size_t keep =
+        options.max_points_per_frame > 0 ? std::min<size_t>(n, options.max_points_per_frame) : n;
     for (size_t k = 0; k < keep; ++k) selected.push_back(static_cast<int>(k * n / keep));
     std::vector<float> weights;
     std::vector<uint8_t> kinds;
@@ -88,9 +87,11 @@ ScoreValue WindowScorer::Evaluate(const CalibrationState& state, int level) {
 }
 
 double WindowScorer::GrayRate(const CalibrationState& state) {
-  return EvaluateOn(state, [](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
-           return cf.gray_map[kind].empty() ? cf.score_maps[kind].back() : cf.gray_map[kind];
-         })
+  return EvaluateOn(state,
+                    [](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
+                      return cf.gray_map[kind].empty() ? cf.score_maps[kind].back()
+                                                       : cf.gray_map[kind];
+                    })
       .gray_rate;
 }
 

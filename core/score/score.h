@@ -17,9 +17,9 @@ struct ScoreOptions {
 };
 
 struct ScoreValue {
-  double score = 0;      ///< weighted sum of map values
-  double gray_rate = 0;  ///< score / 255 / weight sum
-  int projected = 0;     ///< points that landed in the image
+  double score = 0;       ///< weighted sum of map values
+  double gray_rate = 0;   ///< score / 255 / weight sum
+  int projected = 0;      ///< points that landed in the image
   double weight_sum = 0;  ///< sum of the point weights (score = 255·gray_rate·weight_sum)
 };
 

@@ -1,9 +1,9 @@
 #include "core/search/adaptive_grid_search.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <glog/logging.h>
 
 namespace stcalib {
 namespace {
@@ -44,7 +44,8 @@ Status AdaptiveGridSearchOptions::Validate() const {
     return Status::Error("search: step sizes must be > 0");
   }
   if (!(gamma >= 0 && gamma <= 1)) return Status::Error("search: gamma must be in [0, 1]");
-  if (max_iterations < 1 || max_follow_steps < 0) return Status::Error("search: bad iteration caps");
+  if (max_iterations < 1 || max_follow_steps < 0)
+    return Status::Error("search: bad iteration caps");
   if (!(translation_prior_sigma_m > 0) || translation_prior_weight < 0) {
     return Status::Error("search: translation prior sigma must be > 0, weight >= 0");
   }
@@ -70,8 +71,9 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
   // The objective: the score with the translation prior.
   auto objective = [&](const CalibrationState& state, int level) {
     const ScoreValue v = scorer->Evaluate(state, level);
-    const double z = (state.T_camera_lidar.translation() - anchor.T_camera_lidar.translation()).norm() /
-                     options.translation_prior_sigma_m;
+    const double z =
+        (state.T_camera_lidar.translation() - anchor.T_camera_lidar.translation()).norm() /
+        options.translation_prior_sigma_m;
     return v.score - options.translation_prior_weight * 255.0 * v.weight_sum * z * z;
   };
   SearchResult result;
@@ -81,15 +83,16 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
   for (int level = std::clamp(options.first_level, 0, std::max(levels - 1, 0)); level < levels;
        ++level) {
     const bool finest = level == levels - 1;
-    const auto& directions = Directions(options.search_translation &&
-                                        (finest || !options.coarse_levels_rotation_only));
+    const auto& directions =
+        Directions(options.search_translation && (finest || !options.coarse_levels_rotation_only));
     const bool search_time = options.search_time_offset && finest;
     CalibrationState& state = result.state;
     double current = objective(state, level);
     ++result.evaluations;
     bool large = scorer->GrayRate(state) < options.gamma;
     for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
-      const double rot = (large ? options.alpha1_rotation_deg : options.alpha3_rotation_deg) * kDegToRad;
+      const double rot =
+          (large ? options.alpha1_rotation_deg : options.alpha3_rotation_deg) * kDegToRad;
       const double trans = large ? options.alpha2_translation_m : options.alpha4_translation_m;
       double best = current;
       Eigen::Matrix<double, 6, 1> best_dir = Eigen::Matrix<double, 6, 1>::Zero();
@@ -174,8 +177,9 @@ TimeOffsetProfile ProfileTimeOffset(WindowScorer* scorer, const CalibrationState
   // Second local maximum far enough from the best.
   double second = floor;
   for (size_t i = 0; i < profile.scores.size(); ++i) {
-    const bool peak = (i == 0 || profile.scores[i] >= profile.scores[i - 1]) &&
-                      (i + 1 == profile.scores.size() || profile.scores[i] >= profile.scores[i + 1]);
+    const bool peak =
+        (i == 0 || profile.scores[i] >= profile.scores[i - 1]) &&
+        (i + 1 == profile.scores.size() || profile.scores[i] >= profile.scores[i + 1]);
     if (!peak || std::abs(profile.offsets_s[i] - profile.best_s) < min_separation_s) continue;
     if (profile.scores[i] > second) {
       second = profile.scores[i];

@@ -17,13 +17,13 @@ namespace stcalib {
 // offset is interleaved. It runs coarse-to-fine over the score maps of the frames (wide,
 // texture-suppressed basins first), which is what brings it back from several degrees.
 struct AdaptiveGridSearchOptions {
-  double alpha1_rotation_deg = 1.0;   ///< large step pair: rotation [deg]
+  double alpha1_rotation_deg = 1.0;    ///< large step pair: rotation [deg]
   double alpha2_translation_m = 0.04;  ///< large step pair: translation [m]
-  double alpha3_rotation_deg = 0.2;   ///< small step pair: rotation [deg]
+  double alpha3_rotation_deg = 0.2;    ///< small step pair: rotation [deg]
   double alpha4_translation_m = 0.01;  ///< small step pair: translation [m]
-  double gamma = 0.45;                ///< gray-rate threshold between the pairs (finest map)
-  int max_iterations = 25;            ///< neighbourhood evaluations per level
-  int max_follow_steps = 12;          ///< moves along one improving direction
+  double gamma = 0.45;                 ///< gray-rate threshold between the pairs (finest map)
+  int max_iterations = 25;             ///< neighbourhood evaluations per level
+  int max_follow_steps = 12;           ///< moves along one improving direction
   bool search_translation = true;
   bool search_time_offset = true;
   double time_offset_step_s = 0.004;  ///< δ line-search step [s]

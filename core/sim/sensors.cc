@@ -161,7 +161,8 @@ cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, c
     for (int u = 0; u < w; ++u) {
       const size_t i = static_cast<size_t>(v) * w + u;
       bool edge = false;
-      for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+      for (const auto& [du, dv] :
+           {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
         const int uu = u + du, vv = v + dv;
         if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
         const size_t j = static_cast<size_t>(vv) * w + uu;
