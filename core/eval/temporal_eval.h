@@ -20,7 +20,7 @@ struct TemporalEvalOptions {
   double lidar_delay_s = 0.1;      ///< the kept sweeps' stamps are this late [s]
   double drive_time_offset_s = 0;  ///< the drive's own δ (simulated truth or a calibration) [s]
   bool remove_dynamic = false;     ///< drop dynamic points (method.md §5) from every cloud
-  double max_range_m = 40.0;       ///< points beyond are left out of every metric [m]
+  double max_range_m = 120.0;      ///< points beyond are left out of every metric [m]
   int nn_stride = 2;               ///< every n-th predicted point is queried for the NN metric
   NdtOptions ndt;
   IcpOptions icp;

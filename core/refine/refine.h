@@ -31,7 +31,7 @@ struct RefineOptions {
   double prior_sigma_time_s = 0.03;   ///< [s]
   double time_offset_bound_s = 0.15;  ///< |δ| bound [s]
   bool estimate_time_offset = true;
-  int max_points_per_frame = 800;
+  int max_points_per_frame = 300;
   int max_iterations = 30;
   // Observability thresholds on the standard deviations.
   double observable_rotation_deg = 0.15;
