@@ -1,4 +1,6 @@
 // stcalib calibrate: online calibration of a drive (method.md §9).
+#include <glog/logging.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -212,17 +214,13 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     if (!first_frame) first_frame = frame;
     last_frame = frame;
     outcome->reports.push_back(report);
-    if (getenv("STCALIB_DEBUG")) {
+    if (VLOG_IS_ON(1)) {
       const CalibrationError es =
           ComputeCalibrationError(report.search.state, outcome->reference_state);
       const CalibrationError er =
           ComputeCalibrationError(report.refine.state, outcome->reference_state);
-      std::fprintf(stderr,
-                   "\n[debug] frame %d search %.3f deg %.3f m %.1f ms | refine(%d) %.3f deg %.3f m "
-                   "%.1f ms | %s\n",
-                   i, es.rotation_deg, es.translation_norm_m, 1000 * es.time_offset_s,
-                   report.refine.usable, er.rotation_deg, er.translation_norm_m,
-                   1000 * er.time_offset_s, report.reason.c_str());
+      VLOG(1) << "frame " << i << ": search " << ToString(es) << " | refine (usable "
+              << report.refine.usable << ") " << ToString(er) << " | " << report.reason;
     }
     if (job.progress) {
       const CalibrationError e = ComputeCalibrationError(report.after, outcome->reference_state);
@@ -255,9 +253,23 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
                                               outcome->estimate.T_camera_lidar.linear()));
   }
   const int points = final_report.points;
+  const double moved_deg =
+      RotationErrorDeg(outcome->estimate.T_camera_lidar.linear(), initial.T_camera_lidar.linear());
+  const bool at_time_bound =
+      std::abs(outcome->estimate.time_offset_s) >= job.online.time_offset_bound_s - 0.0025;
+  const bool at_rotation_bound = moved_deg >= job.online.search.max_rotation_offset_deg - 0.5;
   if (points < 30) {
     outcome->reason = "not converged: no usable features (" + std::to_string(points) +
                       " LiDAR edge points in the image)";
+  } else if (static_cast<int>(outcome->reports.size()) < 3) {
+    outcome->reason = "not converged: " + std::to_string(outcome->reports.size()) +
+                      " frame(s) cannot show that the estimate has settled (3 needed)";
+  } else if (at_time_bound || at_rotation_bound) {
+    outcome->reason =
+        std::string("not converged: the estimate ran to the bound of its ") +
+        (at_time_bound ? "time offset (|δ| = bound)"
+                       : "rotation search (moved " + std::to_string(moved_deg) + " deg)") +
+        ": the score has no trustworthy optimum inside the bounds";
   } else if (final_report.health < 0.8) {
     outcome->reason = "not converged: health " + std::to_string(final_report.health) +
                       " < 0.8 (the estimate is not a clear optimum of the score)";

@@ -18,13 +18,6 @@ namespace {
 using testing::KittiCalibDir;
 using testing::KittiDriveDir;
 
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(Timestamps, ParsesToTheNanosecond) {
   StampNs stamp = 0;
   ASSERT_TRUE(ParseKittiTimestamp("2011-09-26 13:10:51.168593664", &stamp));
@@ -171,7 +164,7 @@ TEST(KittiWriters, VeloToCamRoundTripIsExactToPrintedPrecision) {
   // 13 significant digits are printed: relative error below 1e-12.
   EXPECT_LT((read.matrix() - T.matrix()).cwiseAbs().maxCoeff(), 1e-12);
   ASSERT_TRUE(WriteVeloToCam(b, read).ok());
-  EXPECT_EQ(Slurp(a), Slurp(b));
+  EXPECT_EQ(testing::ReadFile(a), testing::ReadFile(b));
 }
 
 TEST(KittiWriters, CamToCamRewritesEveryKey) {
@@ -202,8 +195,8 @@ TEST(KittiWriters, OxtsAndVelodyneRoundTripsAreExact) {
   ASSERT_TRUE(
       ReadVelodyneBin(KittiDriveDir() + "/velodyne_points/data/0000000003.bin", &scan).ok());
   ASSERT_TRUE(WriteVelodyneBin(tmp.path() + "/v.bin", scan).ok());
-  EXPECT_EQ(Slurp(tmp.path() + "/v.bin"),
-            Slurp(KittiDriveDir() + "/velodyne_points/data/0000000003.bin"));
+  EXPECT_EQ(testing::ReadFile(tmp.path() + "/v.bin"),
+            testing::ReadFile(KittiDriveDir() + "/velodyne_points/data/0000000003.bin"));
 
   const std::vector<uint8_t> labels = {0, 1, 2, 2, 0};
   ASSERT_TRUE(WritePointLabels(tmp.path() + "/l.bin", labels).ok());

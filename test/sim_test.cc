@@ -159,13 +159,6 @@ TEST(Simulator, OxtsIntegratesToTheTruePoses) {
   }
 }
 
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(Simulator, DriveRoundTripsThroughTheKittiReader) {
   ScopedTempDir tmp;
   const SimulatorOptions options = SmallOptions(7, 3);
@@ -206,7 +199,8 @@ TEST(Simulator, DriveRoundTripsThroughTheKittiReader) {
     EXPECT_EQ(cv::norm(image, f.image_bgr, cv::NORM_INF), 0.0);
     EXPECT_EQ(FormatOxtsPacket(drive.oxts[i]), FormatOxtsPacket(f.oxts));
   }
-  const nlohmann::json truth = nlohmann::json::parse(Slurp(drive.calib_dir + "/ground_truth.json"));
+  const nlohmann::json truth =
+      nlohmann::json::parse(testing::ReadFile(drive.calib_dir + "/ground_truth.json"));
   EXPECT_DOUBLE_EQ(truth["time_offset_s"].get<double>(), 0.03);
   ASSERT_EQ(truth["T_camera_lidar"].size(), 16u);
   for (int k = 0; k < 16; ++k) {
@@ -227,7 +221,8 @@ std::map<std::string, std::string> ReadTree(const std::string& root) {
   std::map<std::string, std::string> files;
   for (const auto& e : std::filesystem::recursive_directory_iterator(root)) {
     if (e.is_regular_file()) {
-      files[std::filesystem::relative(e.path(), root).string()] = Slurp(e.path().string());
+      files[std::filesystem::relative(e.path(), root).string()] =
+          testing::ReadFile(e.path().string());
     }
   }
   return files;
