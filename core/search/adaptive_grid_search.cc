@@ -46,7 +46,8 @@ Status AdaptiveGridSearchOptions::Validate() const {
   if (!(gamma >= 0 && gamma <= 1)) return Status::Error("search: gamma must be in [0, 1]");
   if (max_iterations < 1 || max_follow_steps < 0)
     return Status::Error("search: bad iteration caps");
-  if (!(translation_prior_sigma_m > 0) || translation_prior_weight < 0) {
+  if (!(translation_prior_sigma_m > 0) || translation_prior_weight < 0 ||
+      !(time_offset_prior_sigma_s > 0)) {
     return Status::Error("search: translation prior sigma must be > 0, weight >= 0");
   }
   if (!(time_offset_step_s > 0) || !(time_offset_bound_s >= 0)) {
@@ -74,7 +75,9 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
     const double z =
         (state.T_camera_lidar.translation() - anchor.T_camera_lidar.translation()).norm() /
         options.translation_prior_sigma_m;
-    return v.score - options.translation_prior_weight * 255.0 * v.weight_sum * z * z;
+    const double zt =
+        (state.time_offset_s - anchor.time_offset_s) / options.time_offset_prior_sigma_s;
+    return v.score - options.translation_prior_weight * 255.0 * v.weight_sum * (z * z + zt * zt);
   };
   SearchResult result;
   result.state = start;

@@ -37,9 +37,11 @@ struct AdaptiveGridSearchOptions {
   double max_translation_offset_m = 0.15;
   // Translation prior (method.md §10: δ and the forward translation lie on a ridge): the search
   // maximises score − translation_prior_weight·255·W·(|t − t_anchor| / σ)², W the weight sum,
-  // i.e. a deviation of σ costs `translation_prior_weight` of gray rate.
+  // i.e. a deviation of σ costs `translation_prior_weight` of gray rate; δ likewise.
   double translation_prior_sigma_m = 0.05;
   double translation_prior_weight = 0.01;
+  // The same for δ around the anchor's δ0 [s]: periodic structure gives δ far peaks (§10).
+  double time_offset_prior_sigma_s = 0.03;
 
   Status Validate() const;
 };
