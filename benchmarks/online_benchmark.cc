@@ -1,0 +1,73 @@
+// One online update (issue 5): search + refine over the window, on KITTI frames, in steady state
+// (the calibrator already tracking), and the whole per-frame path including the features.
+// Goal: ≤ 20 ms per frame on one core.
+#include <filesystem>
+
+#include <benchmark/benchmark.h>
+#include <opencv2/core.hpp>
+
+#include "core/online/frame_source.h"
+#include "core/online/online_calibrator.h"
+
+namespace stcalib {
+namespace {
+
+struct Fixture {
+  Drive drive;
+  std::unique_ptr<DriveFrameSource> source;
+  std::vector<std::shared_ptr<const CalibrationFrame>> frames;
+  bool ok = false;
+  Fixture() {
+    cv::setNumThreads(1);
+    const std::string dir =
+        std::string(STCALIB_SHARED_DATA_DIR) + "/kitti/2011_09_26/2011_09_26_drive_0013_sync";
+    if (!std::filesystem::is_directory(dir) || !OpenDrive(dir, "", &drive).ok()) return;
+    if (!DriveFrameSource::Create(&drive, FrameSourceOptions(), &source).ok()) return;
+    for (size_t i = 0; i < 12; ++i) {
+      auto f = std::make_shared<CalibrationFrame>();
+      if (!source->Load(i, f.get()).ok()) return;
+      frames.push_back(f);
+    }
+    ok = true;
+  }
+};
+
+Fixture& Kitti() {
+  static Fixture* fixture = new Fixture();
+  return *fixture;
+}
+
+void BM_OnlineUpdate(benchmark::State& state) {
+  if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
+  CalibrationState initial;
+  initial.T_camera_lidar = Kitti().drive.T_camera_lidar;
+  OnlineCalibratorOptions options;
+  options.refine_frames = static_cast<int>(state.range(0));
+  OnlineCalibrator calibrator(options, initial);
+  for (size_t i = 0; i < 8; ++i) calibrator.AddFrame(Kitti().frames[i]);  // warm: tracking
+  size_t next = 8;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(calibrator.AddFrame(Kitti().frames[next]));
+    next = next + 1 < Kitti().frames.size() ? next + 1 : 8;
+  }
+  state.SetLabel("refine over " + std::to_string(state.range(0)) + " frames, search over 3");
+}
+BENCHMARK(BM_OnlineUpdate)->Arg(3)->Arg(10)->Unit(benchmark::kMillisecond);
+
+// Image features, LiDAR features and local map for one new frame (sweeps before it cached).
+void BM_FrameFeatures(benchmark::State& state) {
+  if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
+  size_t frame = 12;
+  for (auto _ : state) {
+    CalibrationFrame f;
+    benchmark::DoNotOptimize(Kitti().source->Load(frame, &f).ok());
+    frame = frame + 1 < Kitti().drive.NumFrames() ? frame + 1 : 12;
+  }
+  state.SetLabel("includes PNG decoding (~9 ms, see io_benchmark)");
+}
+BENCHMARK(BM_FrameFeatures)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace stcalib
+
+BENCHMARK_MAIN();
