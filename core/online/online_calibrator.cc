@@ -166,7 +166,8 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   report.score_after = scorer.Evaluate(report.after, -1);
   state_ = report.after;
   report.gray_rate_after = scorer.GrayRate(state_);
-  report.health = HealthScore(&scorer, state_);
+  // The health of an unchanged estimate is the one measured before.
+  report.health = report.accepted ? HealthScore(&scorer, state_) : report.health_before;
   return report;
 }
 

@@ -32,7 +32,7 @@ struct RefineOptions {
   double time_offset_bound_s = 0.15;  ///< |δ| bound [s]
   bool estimate_time_offset = true;
   int max_points_per_frame = 300;
-  int max_iterations = 30;
+  int max_iterations = 12;
   // Observability thresholds on the standard deviations.
   double observable_rotation_deg = 0.15;
   double observable_translation_m = 0.04;
