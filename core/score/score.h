@@ -13,7 +13,7 @@ namespace stcalib {
 // rate is score / 255 / (weighted number of points): the mean map value, 0..1.
 struct ScoreOptions {
   double horizontal_weight = 0.5;  ///< w of method.md §6
-  int max_points_per_frame = 400;  ///< evenly thinned for speed; 0 = all
+  int max_points_per_frame = 600;  ///< evenly thinned for speed; 0 = all
 };
 
 struct ScoreValue {
