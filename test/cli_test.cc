@@ -160,6 +160,18 @@ TEST(Cli, CalibrateWithoutFeaturesFailsAndClaimsNothing) {
       RunStcalib("calibrate --drive=" + drive + " --out=" + out + " --num_frames=50").exit_code, 1);
 }
 
+TEST(Cli, CalibrateFromAStartSoWrongNothingProjects) {
+  STCALIB_REQUIRE_KITTI();
+  testing::ScopedTempDir tmp;
+  const std::string out = tmp.path() + "/cal";
+  const RunResult r = RunStcalib("calibrate --drive=" + testing::KittiDriveDir() +
+                                 " --perturb_rot_deg=120 --num_frames=3 --out=" + out);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("not converged"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/calib_velo_to_cam.txt"));
+  EXPECT_THAT(testing::ReadFile(out + "/result.json"), HasSubstr("\"converged\": false"));
+}
+
 TEST(Cli, EvalTemporalBadInput) {
   testing::ScopedTempDir tmp;
   const std::string drive = testing::MakeTinyDrive(tmp.path(), 3);
