@@ -2,6 +2,7 @@
 
 #include <glog/logging.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -100,16 +101,18 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
   auto smooth = [&](double r) { return options.smooth_tolerance_m + options.smooth_per_range * r; };
   auto in_range = [&](double r) { return r >= options.min_range_m && r <= options.max_range_m; };
   std::vector<uint8_t> is_edge(scan.size(), 0);
-  // The silhouette lies between the near return and its far neighbour: the edge
-  // point is put at the near range on the bisecting direction (half a beam or
-  // azimuth step towards the far side), which removes the half-step bias of
-  // taking the near return itself.
-  auto add = [&](int i, EdgeKind kind, int far) {
+  // The silhouette lies between the near return and the direction of its far
+  // neighbour: the edge point is put at the near range on the bisecting direction
+  // (half a beam or azimuth step towards the far side), which removes the
+  // half-step bias of taking the near return itself. `far_direction` is the far
+  // neighbour's direction, or the direction of the missing return (sky) it would
+  // have had; zero when unknown.
+  auto add = [&](int i, EdgeKind kind, const Eigen::Vector3d &far_direction) {
     if (is_edge[i]) return;
     is_edge[i] = 1;
     Eigen::Vector3d p = scan.points_lidar[i];
-    if (far >= 0) {
-      const Eigen::Vector3d bisector = p.normalized() + scan.points_lidar[far].normalized();
+    if (!far_direction.isZero()) {
+      const Eigen::Vector3d bisector = p.normalized() + far_direction.normalized();
       if (bisector.norm() > 1e-6) p = bisector.normalized() * rings.range_m[i];
     }
     edges.points_lidar.push_back(p);
@@ -159,7 +162,14 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
           previous = rn;
         }
         if (smooth_side) {
-          add(i, EdgeKind::kVertical, j);
+          Eigen::Vector3d far_direction = Eigen::Vector3d::Zero();
+          if (j >= 0) {
+            far_direction = scan.points_lidar[j];
+          } else {  // no return: one azimuth step further round, same elevation
+            far_direction =
+                Eigen::AngleAxisd(dir * step, Eigen::Vector3d::UnitZ()) * scan.points_lidar[i];
+          }
+          add(i, EdgeKind::kVertical, far_direction);
           break;
         }
       }
@@ -205,7 +215,20 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
         if (std::isnan(other) || other - r < jump(r)) continue;
         const float next = vertical_neighbour(static_cast<int>(i), -dir, &unused);
         if (std::isfinite(next) && std::abs(next - r) < smooth(r)) {
-          add(static_cast<int>(i), EdgeKind::kHorizontal, far);
+          Eigen::Vector3d far_direction = Eigen::Vector3d::Zero();
+          if (far >= 0) {
+            far_direction = scan.points_lidar[far];
+          } else {  // no return (sky): the adjacent ring's elevation, same azimuth
+            const int rank = rings.elevation_rank[rings.ring[i]] + dir;
+            if (rank >= 0 && rank < rings.num_rings()) {
+              const double elevation = rings.ring_elevation_rad[rings.order_by_elevation[rank]];
+              const double azimuth = rings.azimuth_rad[i];
+              far_direction =
+                  Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                                  std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+            }
+          }
+          add(static_cast<int>(i), EdgeKind::kHorizontal, far_direction);
           break;
         }
       }

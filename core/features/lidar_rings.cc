@@ -50,6 +50,7 @@ ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points) {
     std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
     rings.azimuth_step_rad = steps[steps.size() / 2];
   }
+  rings.ring_elevation_rad = elevation;
   rings.order_by_elevation.resize(rings.num_rings());
   std::iota(rings.order_by_elevation.begin(), rings.order_by_elevation.end(), 0);
   std::stable_sort(rings.order_by_elevation.begin(), rings.order_by_elevation.end(),

@@ -11,13 +11,14 @@ namespace stcalib {
 // the way round to just right of it, and lasers follow each other. A laser ends where the
 // azimuth, having passed the ±180° wrap, crosses from negative to positive.
 struct ScanRings {
-  std::vector<uint16_t> ring;           ///< ring of every point, in file order
-  std::vector<float> azimuth_rad;       ///< atan2(y, x) of every point, (−π, π]
-  std::vector<float> range_m;           ///< |p| of every point
-  std::vector<int> ring_begin;          ///< first point of each ring; back() = number of points
-  std::vector<int> order_by_elevation;  ///< rings sorted from the top beam to the bottom one
-  std::vector<int> elevation_rank;      ///< inverse of order_by_elevation
-  double azimuth_step_rad = 0;          ///< median spacing of consecutive returns in a ring
+  std::vector<uint16_t> ring;              ///< ring of every point, in file order
+  std::vector<float> azimuth_rad;          ///< atan2(y, x) of every point, (−π, π]
+  std::vector<float> range_m;              ///< |p| of every point
+  std::vector<int> ring_begin;             ///< first point of each ring; back() = number of points
+  std::vector<int> order_by_elevation;     ///< rings sorted from the top beam to the bottom one
+  std::vector<int> elevation_rank;         ///< inverse of order_by_elevation
+  double azimuth_step_rad = 0;             ///< median spacing of consecutive returns in a ring
+  std::vector<double> ring_elevation_rad;  ///< mean elevation of each ring's returns [rad]
 
   int num_rings() const { return static_cast<int>(ring_begin.size()) - 1; }
 };
