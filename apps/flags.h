@@ -49,3 +49,4 @@ DECLARE_bool(oriented_maps);
 DECLARE_int32(lidar_decimation);
 DECLARE_double(lidar_delay_s);
 DECLARE_double(eval_max_range_m);
+DECLARE_bool(coarse_until_window_full);

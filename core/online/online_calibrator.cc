@@ -114,7 +114,8 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   report.gray_rate_before = scorer.GrayRate(state_);
   report.health_before = HealthScore(&scorer, state_);
   report.coarse_search = report.health_before < options_.lost_health ||
-                         static_cast<int>(frames.size()) < options_.window_frames;
+                         (options_.coarse_until_window_full &&
+                          static_cast<int>(frames.size()) < options_.window_frames);
   search_options.first_level = report.coarse_search ? 0 : scorer.num_levels() - 1;
   report.search = AdaptiveGridSearch(&scorer, state_, anchor_, search_options);
   report.search_ms = MillisecondsSince(start);

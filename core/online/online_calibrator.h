@@ -24,6 +24,7 @@ struct OnlineCalibratorOptions {
   // the estimate may be far off: the search runs coarse-to-fine from the widest map instead of
   // on the finest one only.
   double lost_health = 0.9;
+  bool coarse_until_window_full = true;
   // Points are kept when they project inside the image shrunk by this share of its size on
   // each side, at the estimate when their frame arrives.
   double point_margin = 0.02;
