@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <unistd.h>
 
 #include "apps/calibrate_job.h"
 #include "apps/commands.h"
@@ -225,15 +226,19 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     }
     if (job.progress) {
       const CalibrationError e = ComputeCalibrationError(report.after, outcome->reference_state);
+      // An updating line on a terminal, one line per frame in a log.
+      const bool terminal = isatty(fileno(stderr));
       std::fprintf(
           stderr,
-          "\rcalibrate: frame %d/%d  %s %.3f deg, %.3f m, dt %+.1f ms  gray %.2f  health %.2f   ",
+          "%scalibrate: frame %d/%d  %s %.3f deg, %.3f m, dt %+.1f ms  gray %.2f  health %.2f   ",
+          terminal ? "\r" : "",
           i - first + 1, last - first + 1, outcome->has_truth ? "error" : "vs drive calib",
           e.rotation_deg, e.translation_norm_m, 1000 * report.after.time_offset_s,
           report.gray_rate_after, report.health);
+      if (!terminal) std::fprintf(stderr, "\n");
     }
   }
-  if (job.progress) std::fprintf(stderr, "\n");
+  if (job.progress && isatty(fileno(stderr))) std::fprintf(stderr, "\n");
   outcome->mean_frame_ms = frame_ms_sum / outcome->reports.size();
   outcome->estimate = calibrator.state();
   outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
