@@ -1,5 +1,6 @@
 // stcalib calibrate: online calibration of a drive (method.md §9).
 #include <glog/logging.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -8,7 +9,6 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
-#include <unistd.h>
 
 #include "apps/calibrate_job.h"
 #include "apps/commands.h"
@@ -22,25 +22,6 @@ namespace stcalib::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-Status ReadGroundTruth(const std::string& path, CalibrationState* truth) {
-  std::vector<std::string> lines;
-  STCALIB_RETURN_IF_ERROR(ReadLines(path, &lines));
-  std::string text;
-  for (const auto& l : lines) text += l + "\n";
-  try {
-    const nlohmann::json j = nlohmann::json::parse(text);
-    const auto& m = j.at("T_camera_lidar");
-    if (m.size() != 16) return Status::Error(path + ": T_camera_lidar must have 16 numbers");
-    Eigen::Matrix4d T;
-    for (int k = 0; k < 16; ++k) T(k / 4, k % 4) = m.at(k).get<double>();
-    truth->T_camera_lidar.matrix() = T;
-    truth->time_offset_s = j.at("time_offset_s").get<double>();
-  } catch (const std::exception& e) {
-    return Status::Error(path + ": " + e.what());
-  }
-  return Status::Ok();
-}
 
 nlohmann::json MatrixJson(const Rigid3d& T) {
   nlohmann::json values = nlohmann::json::array();
@@ -160,10 +141,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   if (!status.ok()) return ReportError(kCommand, status);
 
   // Reference: simulated ground truth when present, else the drive's own calibration.
-  const std::string truth_path = drive.calib_dir + "/ground_truth.json";
-  outcome->has_truth = fs::exists(truth_path);
+  status = ReadGroundTruth(drive, &outcome->has_truth, &outcome->reference_state);
+  if (!status.ok()) return ReportError(kCommand, status);
   if (outcome->has_truth) {
-    status = ReadGroundTruth(truth_path, &outcome->reference_state);
     if (!status.ok()) return ReportError(kCommand, status);
     outcome->reference = "ground truth (simulated)";
   } else {
@@ -231,10 +211,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       std::fprintf(
           stderr,
           "%scalibrate: frame %d/%d  %s %.3f deg, %.3f m, dt %+.1f ms  gray %.2f  health %.2f   ",
-          terminal ? "\r" : "",
-          i - first + 1, last - first + 1, outcome->has_truth ? "error" : "vs drive calib",
-          e.rotation_deg, e.translation_norm_m, 1000 * report.after.time_offset_s,
-          report.gray_rate_after, report.health);
+          terminal ? "\r" : "", i - first + 1, last - first + 1,
+          outcome->has_truth ? "error" : "vs drive calib", e.rotation_deg, e.translation_norm_m,
+          1000 * report.after.time_offset_s, report.gray_rate_after, report.health);
       if (!terminal) std::fprintf(stderr, "\n");
     }
   }

@@ -98,19 +98,11 @@ int RunEvalTemporal() {
   status = options.Validate();
   if (!status.ok()) return UsageError(kCommand, status.message());
   // A simulated drive knows its own δ.
-  const std::string truth_path = drive.calib_dir + "/ground_truth.json";
-  if (std::filesystem::exists(truth_path)) {
-    std::vector<std::string> lines;
-    status = ReadLines(truth_path, &lines);
-    if (!status.ok()) return ReportError(kCommand, status);
-    std::string text;
-    for (const auto& l : lines) text += l;
-    try {
-      options.drive_time_offset_s = nlohmann::json::parse(text).at("time_offset_s").get<double>();
-    } catch (const std::exception& e) {
-      return ReportError(kCommand, Status::Error(truth_path + ": " + e.what()));
-    }
-  }
+  bool simulated = false;
+  CalibrationState truth;
+  status = ReadGroundTruth(drive, &simulated, &truth);
+  if (!status.ok()) return ReportError(kCommand, status);
+  if (simulated) options.drive_time_offset_s = truth.time_offset_s;
   std::error_code ec;
   std::filesystem::create_directories(FLAGS_out, ec);
   std::string md = "# Temporal evaluation (method.md §8)\n\nDrive " + drive.drive_dir +

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "core/io/drive.h"
+#include "core/types/calibration.h"
 #include "core/types/status.h"
 
 namespace stcalib::cli {
@@ -24,6 +25,9 @@ int RunEvalTemporal();
 int ReportError(const std::string& command, const Status& status);
 // Prints a usage error and returns kExitUsage.
 int UsageError(const std::string& command, const std::string& message);
+// Reads ground_truth.json beside a simulated drive's calibration; *found is false (and the
+// status ok) when the drive has none.
+Status ReadGroundTruth(const Drive& drive, bool* found, CalibrationState* truth);
 // Opens --drive with --calib_dir.
 Status OpenDriveFromFlags(Drive* drive);
 

@@ -1,7 +1,10 @@
+#include <filesystem>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
 #include "apps/flags.h"
+#include "core/io/text.h"
 
 namespace stcalib::cli {
 
@@ -14,6 +17,28 @@ int UsageError(const std::string& command, const std::string& message) {
   std::cerr << "stcalib " << command << ": usage error: " << message << "\n(run `stcalib "
             << command << " --help`)\n";
   return kExitUsage;
+}
+
+Status ReadGroundTruth(const Drive& drive, bool* found, CalibrationState* truth) {
+  const std::string path = drive.calib_dir + "/ground_truth.json";
+  *found = std::filesystem::exists(path);
+  if (!*found) return Status::Ok();
+  std::vector<std::string> lines;
+  STCALIB_RETURN_IF_ERROR(ReadLines(path, &lines));
+  std::string text;
+  for (const auto& l : lines) text += l + "\n";
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    const auto& m = j.at("T_camera_lidar");
+    if (m.size() != 16) return Status::Error(path + ": T_camera_lidar must have 16 numbers");
+    Eigen::Matrix4d T;
+    for (int k = 0; k < 16; ++k) T(k / 4, k % 4) = m.at(k).get<double>();
+    truth->T_camera_lidar.matrix() = T;
+    truth->time_offset_s = j.at("time_offset_s").get<double>();
+  } catch (const std::exception& e) {
+    return Status::Error(path + ": " + e.what());
+  }
+  return Status::Ok();
 }
 
 Status OpenDriveFromFlags(Drive* drive) { return OpenDrive(FLAGS_drive, FLAGS_calib_dir, drive); }

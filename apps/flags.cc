@@ -58,4 +58,5 @@ DEFINE_double(disturb_rot_deg, 2.0,
 DEFINE_int32(lidar_decimation, 2, "eval-temporal: keep every n-th sweep");
 DEFINE_double(lidar_delay_s, 0.1, "eval-temporal: the kept sweeps arrive this late [s]");
 DEFINE_double(eval_max_range_m, 120.0, "eval-temporal: points beyond this range are left out [m]");
-DEFINE_bool(coarse_until_window_full, true, "calibrate: coarse-to-fine search on every frame until the search window is full");
+DEFINE_bool(coarse_until_window_full, true,
+            "calibrate: coarse-to-fine search on every frame until the search window is full");
