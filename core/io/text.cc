@@ -47,11 +47,15 @@ bool ParseNumbers(const std::string& text, std::vector<double>* values, std::str
 }
 
 Status WriteTextFile(const std::string& path, const std::string& contents) {
+  return WriteFileAtomically(path, contents.data(), contents.size());
+}
+
+Status WriteFileAtomically(const std::string& path, const char* data, size_t size) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) return Status::Error(path + ": cannot write: " + std::strerror(errno));
-    out << contents;
+    out.write(data, static_cast<std::streamsize>(size));
     out.flush();
     if (!out) return Status::Error(path + ": write failed");
   }

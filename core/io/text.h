@@ -17,6 +17,8 @@ bool ParseNumbers(const std::string& text, std::vector<double>* values,
 
 // Writes `contents` to `path` atomically enough for our needs: to `path.tmp`, then renamed.
 Status WriteTextFile(const std::string& path, const std::string& contents);
+// Writes bytes to `path.tmp`, then renames it onto `path`.
+Status WriteFileAtomically(const std::string& path, const char* data, size_t size);
 
 // True when the line holds only whitespace.
 bool IsBlank(const std::string& line);

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/io/text.h"
+
 namespace stcalib {
 namespace {
 
@@ -22,20 +24,6 @@ Status ReadBytes(const std::string& path, std::vector<char>* bytes) {
   in.seekg(0, std::ios::beg);
   bytes->resize(static_cast<size_t>(size));
   if (size > 0 && !in.read(bytes->data(), size)) return Status::Error(path + ": read error");
-  return Status::Ok();
-}
-
-Status WriteBytes(const std::string& path, const char* data, size_t size) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Status::Error(path + ": cannot write: " + std::strerror(errno));
-    out.write(data, static_cast<std::streamsize>(size));
-    if (!out) return Status::Error(path + ": write failed");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) return Status::Error(path + ": cannot rename from " + tmp + ": " + ec.message());
   return Status::Ok();
 }
 
@@ -82,7 +70,8 @@ Status WriteVelodyneBin(const std::string& path, const LidarScan& scan) {
     data[4 * i + 2] = static_cast<float>(scan.points_lidar[i].z());
     data[4 * i + 3] = scan.reflectance[i];
   }
-  return WriteBytes(path, reinterpret_cast<const char*>(data.data()), data.size() * sizeof(float));
+  return WriteFileAtomically(path, reinterpret_cast<const char*>(data.data()),
+                             data.size() * sizeof(float));
 }
 
 Status ReadPointLabels(const std::string& path, std::vector<uint8_t>* labels) {
@@ -99,7 +88,7 @@ Status ReadPointLabels(const std::string& path, std::vector<uint8_t>* labels) {
 }
 
 Status WritePointLabels(const std::string& path, const std::vector<uint8_t>& labels) {
-  return WriteBytes(path, reinterpret_cast<const char*>(labels.data()), labels.size());
+  return WriteFileAtomically(path, reinterpret_cast<const char*>(labels.data()), labels.size());
 }
 
 }  // namespace stcalib
