@@ -108,11 +108,17 @@ CalibrateJob CalibrateJobFromFlags() {
   o.refine.horizontal_weight = FLAGS_horizontal_weight;
   o.refine.prior_sigma_rotation_deg = FLAGS_prior_sigma_rotation_deg;
   o.refine.prior_sigma_translation_m = FLAGS_prior_sigma_translation_m;
+  o.refine.prior_sigma_forward_m = FLAGS_prior_sigma_forward_m;
+  o.refine.prior_sigma_time_s = FLAGS_prior_sigma_time_s;
+  o.refine.max_points_per_frame = FLAGS_max_points_per_frame;
+  o.refine_frames = FLAGS_refine_frames;
+  o.tracking_gain = FLAGS_tracking_gain;
   o.refine.observable_rotation_deg = FLAGS_observable_rotation_deg;
   o.refine.observable_translation_m = FLAGS_observable_translation_m;
   o.refine.observable_time_s = FLAGS_observable_time_s;
   job.source.local_map.sweeps = FLAGS_local_map_sweeps;
   job.source.local_map.use_ndt = FLAGS_use_ndt;
+  job.source.lidar.remove_dynamic = FLAGS_remove_dynamic;
   job.source.suppress_texture = FLAGS_suppress_texture;
   job.source.oriented_maps = FLAGS_oriented_maps;
   return job;

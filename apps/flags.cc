@@ -39,12 +39,19 @@ DEFINE_double(gamma, 0.45, "search: gray-rate threshold between the large and th
 DEFINE_double(lost_health, 0.9, "calibrate: below this health the search goes coarse-to-fine");
 DEFINE_double(prior_sigma_rotation_deg, 2.0, "refine: weak rotation prior [deg]");
 DEFINE_double(prior_sigma_translation_m, 0.05, "refine: translation prior [m]");
+DEFINE_double(prior_sigma_forward_m, 0.05,
+              "refine: translation prior along the direction of travel, per point [m]");
+DEFINE_double(prior_sigma_time_s, 0.03, "refine: time-offset prior towards δ0 [s]");
+DEFINE_int32(refine_frames, 10, "calibrate: latest frames in the refinement");
+DEFINE_int32(max_points_per_frame, 300, "refine: LiDAR edge points used per frame");
+DEFINE_double(tracking_gain, 1.0, "calibrate: share of an accepted update taken while tracking");
 DEFINE_double(observable_rotation_deg, 0.15,
               "refine: a rotation axis is observable below this std [deg]");
 DEFINE_double(observable_translation_m, 0.04,
               "refine: a translation axis is observable below this std [m]");
 DEFINE_double(observable_time_s, 0.006, "refine: δ is observable below this std [s]");
 DEFINE_int32(local_map_sweeps, 3, "calibrate: sweeps merged into the local map");
+DEFINE_bool(remove_dynamic, true, "calibrate: remove LiDAR points of moving objects");
 DEFINE_bool(use_ndt, false, "calibrate: refine the local map's poses with PCL NDT");
 DEFINE_bool(suppress_texture, false, "calibrate: score on texture-suppressed maps");
 DEFINE_bool(

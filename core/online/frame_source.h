@@ -18,7 +18,13 @@ struct FrameSourceOptions {
   bool suppress_texture = false;  ///< score maps are the texture-suppressed IDTs
   bool oriented_maps = true;      ///< vertical/horizontal LiDAR edges read their own maps
 
-  FrameSourceOptions() { image.pyramid_basins_px = {60, 30}; }
+  FrameSourceOptions() {
+    image.pyramid_basins_px = {60, 30};
+    // Calibration wants precision over recall from the dynamic filter: a moving point left in
+    // costs little under the robust loss, but a static structure removed because its occlusion
+    // boundaries moved between viewpoints takes the nearest, most informative edges with it.
+    lidar.dynamic.min_flagged_fraction = 0.3;
+  }
   Status Validate() const;
 };
 
