@@ -157,18 +157,11 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     outcome->reference = "drive calibration (" + drive.calib_dir + "/calib_velo_to_cam.txt)";
   }
   CalibrationState initial;
-  initial.T_camera_lidar = drive.T_camera_lidar;
-  if (!job.init_calib.empty()) {
-    status = ReadVeloToCam(job.init_calib, &initial.T_camera_lidar);
-    if (!status.ok()) return ReportError(kCommand, status);
-  }
   std::mt19937_64 rng(job.seed);
   auto sign = [&]() { return (rng() & 1) ? 1.0 : -1.0; };
-  const Eigen::Vector3d rpy(sign() * job.perturb_rot_deg, sign() * job.perturb_rot_deg,
-                            sign() * job.perturb_rot_deg);
-  const Eigen::Vector3d dt(sign() * job.perturb_trans_m, sign() * job.perturb_trans_m,
-                           sign() * job.perturb_trans_m);
-  initial.T_camera_lidar = PerturbTcameraLidar(initial.T_camera_lidar, rpy, dt);
+  status = StartingCalibration(drive, job.init_calib, job.perturb_rot_deg, job.perturb_trans_m,
+                               &rng, &initial.T_camera_lidar);
+  if (!status.ok()) return ReportError(kCommand, status);
   initial.time_offset_s = job.perturb_time_s;
   outcome->initial = initial;
   outcome->initial_error = ComputeCalibrationError(initial, outcome->reference_state);

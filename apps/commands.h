@@ -1,5 +1,6 @@
 #pragma once
 
+#include <random>
 #include <string>
 
 #include "core/io/drive.h"
@@ -20,6 +21,7 @@ int RunFeatures();
 int RunCalibrate();
 int RunDemo();
 int RunEvalTemporal();
+int RunCheck();
 
 // Prints "stcalib <command>: error: <message>" to stderr and returns kExitFailure.
 int ReportError(const std::string& command, const Status& status);
@@ -28,6 +30,12 @@ int UsageError(const std::string& command, const std::string& message);
 // Reads ground_truth.json beside a simulated drive's calibration; *found is false (and the
 // status ok) when the drive has none.
 Status ReadGroundTruth(const Drive& drive, bool* found, CalibrationState* truth);
+// The calibration a run starts from: `init_calib` (a calib_velo_to_cam.txt; empty: the drive's
+// own), perturbed by ±perturb_rot_deg on roll, pitch and yaw and ±perturb_trans_m on x, y, z with
+// signs drawn from `rng` (in that order).
+Status StartingCalibration(const Drive& drive, const std::string& init_calib,
+                           double perturb_rot_deg, double perturb_trans_m, std::mt19937_64* rng,
+                           Rigid3d* T_camera_lidar);
 // Opens --drive with --calib_dir.
 Status OpenDriveFromFlags(Drive* drive);
 

@@ -4,6 +4,7 @@
 
 #include "apps/commands.h"
 #include "apps/flags.h"
+#include "core/io/kitti_calib.h"
 #include "core/io/text.h"
 
 namespace stcalib::cli {
@@ -38,6 +39,20 @@ Status ReadGroundTruth(const Drive& drive, bool* found, CalibrationState* truth)
   } catch (const std::exception& e) {
     return Status::Error(path + ": " + e.what());
   }
+  return Status::Ok();
+}
+
+Status StartingCalibration(const Drive& drive, const std::string& init_calib,
+                           double perturb_rot_deg, double perturb_trans_m, std::mt19937_64* rng,
+                           Rigid3d* T_camera_lidar) {
+  *T_camera_lidar = drive.T_camera_lidar;
+  if (!init_calib.empty()) STCALIB_RETURN_IF_ERROR(ReadVeloToCam(init_calib, T_camera_lidar));
+  auto sign = [&]() { return ((*rng)() & 1) ? 1.0 : -1.0; };
+  const Eigen::Vector3d rpy(sign() * perturb_rot_deg, sign() * perturb_rot_deg,
+                            sign() * perturb_rot_deg);
+  const Eigen::Vector3d dt(sign() * perturb_trans_m, sign() * perturb_trans_m,
+                           sign() * perturb_trans_m);
+  *T_camera_lidar = PerturbTcameraLidar(*T_camera_lidar, rpy, dt);
   return Status::Ok();
 }
 

@@ -47,6 +47,14 @@ const std::vector<Subcommand>& Subcommands() {
        "the paper's Table I: ApproximateTime pairing vs the motion model (filter_cloud, "
        "infer_cloud, infer_cloud_interpolation)",
        &RunEvalTemporal},
+      {"check",
+       "--drive=DRIVE_DIR [--calib_dir=DIR] [--init_calib=FILE] [--perturb_rot_deg=D] "
+       "[--perturb_trans_m=M] [--perturb_time_s=S (its time offset)] [--seed=S] [--first_frame=I] "
+       "[--num_frames=N] [--out=DIR] "
+       "[--min_health=H]",
+       "health score of the stored calibration per window of frames; exit 0 when it holds, 1 "
+       "when it is off, with the evidence",
+       &RunCheck},
       {"demo", "[--out=DIR] [--seed=S]",
        "simulate a drive (true time offset +30 ms), calibrate it from +-2 deg / +-5 cm, print "
        "truth, start, estimate and error",

@@ -172,6 +172,24 @@ TEST(Cli, CalibrateFromAStartSoWrongNothingProjects) {
   EXPECT_THAT(testing::ReadFile(out + "/result.json"), HasSubstr("\"converged\": false"));
 }
 
+TEST(Cli, CheckHoldsForKittiCalibrationAndCatchesOneDegreeOff) {
+  STCALIB_REQUIRE_KITTI();
+  testing::ScopedTempDir tmp;
+  const RunResult good =
+      RunStcalib("check --drive=" + testing::KittiDriveDir() + " --out=" + tmp.path() + " ");
+  EXPECT_EQ(good.exit_code, 0) << good.output;
+  EXPECT_THAT(good.output, HasSubstr("the calibration holds"));
+  EXPECT_THAT(good.output, HasSubstr("frames   27-29"));
+  EXPECT_THAT(testing::ReadFile(tmp.path() + "/check.json"), HasSubstr("\"holds\": true"));
+  // 0.58° on each of roll, pitch and yaw: 1° in all.
+  const RunResult off =
+      RunStcalib("check --drive=" + testing::KittiDriveDir() + " --perturb_rot_deg=0.58 --seed=3");
+  EXPECT_EQ(off.exit_code, 1) << off.output;
+  EXPECT_THAT(off.output, HasSubstr("the calibration is off"));
+  EXPECT_EQ(RunStcalib("check").exit_code, 2);
+  EXPECT_EQ(RunStcalib("check --drive=" + tmp.path() + "/absent").exit_code, 1);
+}
+
 TEST(Cli, EvalTemporalBadInput) {
   testing::ScopedTempDir tmp;
   const std::string drive = testing::MakeTinyDrive(tmp.path(), 3);

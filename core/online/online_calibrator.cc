@@ -47,33 +47,6 @@ OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
   anchor_ = state_;
 }
 
-std::shared_ptr<const CalibrationFrame> OnlineCalibrator::Prune(
-    std::shared_ptr<const CalibrationFrame> frame) const {
-  // Keep the points that project inside the image (with a margin) at the current estimate, and
-  // score only those: a score over all points would reward calibrations that pull outside
-  // points into the image, and run away in translation.
-  auto pruned = std::make_shared<CalibrationFrame>(*frame);
-  pruned->points_lidar.clear();
-  pruned->kinds.clear();
-  const double mu = -options_.point_margin * frame->camera.width;
-  const double mv = -options_.point_margin * frame->camera.height;
-  const double e = frame->e0_s + state_.time_offset_s;
-  for (size_t i = 0; i < frame->size(); ++i) {
-    const Eigen::Vector3d p =
-        state_.T_camera_lidar * ApplyLidarMotion<double>(frame->twist, e, frame->points_lidar[i]);
-    Eigen::Vector2d pixel;
-    double depth;
-    if (!frame->camera.Project<double>(p, &pixel, &depth)) continue;
-    if (pixel.x() < -mu || pixel.y() < -mv || pixel.x() > frame->camera.width + mu ||
-        pixel.y() > frame->camera.height + mv) {
-      continue;
-    }
-    pruned->points_lidar.push_back(frame->points_lidar[i]);
-    pruned->kinds.push_back(frame->kinds[i]);
-  }
-  return pruned;
-}
-
 std::vector<const CalibrationFrame*> OnlineCalibrator::SearchWindow() const {
   std::vector<const CalibrationFrame*> frames;
   const size_t n = std::min<size_t>(window_.size(), options_.window_frames);
@@ -85,7 +58,7 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   FrameReport report;
   report.frame = frame->index;
   report.before = state_;
-  window_.push_back(Prune(frame));
+  window_.push_back(PruneToImage(*frame, state_, options_.point_margin));
   while (static_cast<int>(window_.size()) >
          std::max(options_.window_frames, options_.refine_frames)) {
     window_.pop_front();

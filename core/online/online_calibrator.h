@@ -67,9 +67,6 @@ class OnlineCalibrator {
   std::vector<const CalibrationFrame*> SearchWindow() const;
 
  private:
-  std::shared_ptr<const CalibrationFrame> Prune(
-      std::shared_ptr<const CalibrationFrame> frame) const;
-
   OnlineCalibratorOptions options_;
   CalibrationState state_;
   CalibrationState anchor_;  ///< the initial calibration: the search's bounds are around it

@@ -126,9 +126,34 @@ ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& 
   return value;
 }
 
+std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& frame,
+                                                     const CalibrationState& state, double margin) {
+  auto pruned = std::make_shared<CalibrationFrame>(frame);
+  pruned->points_lidar.clear();
+  pruned->kinds.clear();
+  const double mu = margin * frame.camera.width;
+  const double mv = margin * frame.camera.height;
+  const double e = frame.e0_s + state.time_offset_s;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const Eigen::Vector3d p =
+        state.T_camera_lidar * ApplyLidarMotion<double>(frame.twist, e, frame.points_lidar[i]);
+    Eigen::Vector2d pixel;
+    double depth;
+    if (!frame.camera.Project<double>(p, &pixel, &depth)) continue;
+    if (pixel.x() < mu || pixel.y() < mv || pixel.x() > frame.camera.width - mu ||
+        pixel.y() > frame.camera.height - mv) {
+      continue;
+    }
+    pruned->points_lidar.push_back(frame.points_lidar[i]);
+    pruned->kinds.push_back(frame.kinds[i]);
+  }
+  return pruned;
+}
+
 double HealthScore(WindowScorer* scorer, const CalibrationState& state, double rotation_deg,
-                   double translation_m) {
+                   double translation_m, double* best_gain) {
   const double centre = scorer->Evaluate(state, -1).score;
+  double best = -std::numeric_limits<double>::infinity();
   const double r = rotation_deg * M_PI / 180.0;
   int worse = 0, total = 0;
   for (int code = 0; code < 729; ++code) {
@@ -140,9 +165,12 @@ double HealthScore(WindowScorer* scorer, const CalibrationState& state, double r
       c /= 3;
     }
     const CalibrationState n = Step(state, r * d.head<3>(), translation_m * d.tail<3>(), 0.0);
-    worse += scorer->Evaluate(n, -1).score < centre;
+    const double value = scorer->Evaluate(n, -1).score;
+    worse += value < centre;
+    best = std::max(best, value);
     ++total;
   }
+  if (best_gain != nullptr) *best_gain = centre > 0 ? best / centre - 1.0 : 0.0;
   return static_cast<double>(worse) / total;
 }
 

@@ -61,9 +61,17 @@ class WindowScorer {
 CalibrationState Step(const CalibrationState& state, const Eigen::Vector3d& rotation_rad,
                       const Eigen::Vector3d& translation_m, double time_offset_s);
 
+// The frame with only the edge points that project inside the image shrunk by `margin` (a share
+// of its size on each side) at `state`. Scores compare calibrations on the same points: a score
+// over all points would reward calibrations that pull outside points into the image.
+std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& frame,
+                                                     const CalibrationState& state, double margin);
+
 // Health score (method.md §7): the share of the 728 grid neighbours at ±`rotation_deg` /
 // ±`translation_m` that score worse than `state` on the finest map.
+// `best_gain` (optional) receives the largest relative score gain of a neighbour over `state`
+// (score(neighbour) / score(state) − 1; ≤ 0 when `state` beats all of them).
 double HealthScore(WindowScorer* scorer, const CalibrationState& state, double rotation_deg = 1.0,
-                   double translation_m = 0.05);
+                   double translation_m = 0.05, double* best_gain = nullptr);
 
 }  // namespace stcalib
