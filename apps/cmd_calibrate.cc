@@ -176,11 +176,16 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   std::shared_ptr<const CalibrationFrame> first_frame, last_frame;
   const auto run_start = std::chrono::steady_clock::now();
   double frame_ms_sum = 0;
+  int frames_used = 0;
   for (int i = first; i <= last; ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     auto frame = std::make_shared<CalibrationFrame>();
     status = source->Load(i, frame.get());
-    if (!status.ok()) return ReportError(kCommand, status);
+    if (!status.ok()) {
+      // Bad data in one frame (unreadable sweep or image, oxts gap): keep the estimate, go on.
+      outcome->reports.push_back(calibrator.SkipFrame(i, status.message()));
+      continue;
+    }
     if (i == job.disturb_frame) {
       const Eigen::Vector3d d(sign() * job.disturb_rot_deg, sign() * job.disturb_rot_deg,
                               sign() * job.disturb_rot_deg);
@@ -192,8 +197,11 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     FrameReport report = calibrator.AddFrame(frame);
     frame_ms_sum +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (!first_frame) first_frame = frame;
-    last_frame = frame;
+    if (!report.skipped) {
+      if (!first_frame) first_frame = frame;
+      last_frame = frame;
+      ++frames_used;
+    }
     outcome->reports.push_back(report);
     if (VLOG_IS_ON(1)) {
       const CalibrationError es =
@@ -217,7 +225,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     }
   }
   if (job.progress && isatty(fileno(stderr))) std::fprintf(stderr, "\n");
-  outcome->mean_frame_ms = frame_ms_sum / outcome->reports.size();
+  outcome->mean_frame_ms = frame_ms_sum / std::max(1, frames_used);
   outcome->estimate = calibrator.state();
   outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
 
@@ -227,27 +235,36 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       ProfileTimeOffset(&scorer, outcome->estimate, job.online.time_offset_bound_s, 0.0025);
   outcome->alias_suspect = profile.alias_suspect;
 
-  // Convergence: the last frame's health is high and the estimate has settled.
-  const FrameReport& final_report = outcome->reports.back();
-  double settle_deg = 0;
-  for (size_t k = outcome->reports.size() >= 3 ? outcome->reports.size() - 3 : 0;
-       k < outcome->reports.size(); ++k) {
-    settle_deg =
-        std::max(settle_deg, RotationErrorDeg(outcome->reports[k].after.T_camera_lidar.linear(),
-                                              outcome->estimate.T_camera_lidar.linear()));
+  // Convergence: the last used frame's health is high and the estimate has settled over the
+  // last three used frames (skipped frames say nothing).
+  std::vector<const FrameReport*> used;
+  for (const FrameReport& r : outcome->reports) {
+    if (!r.skipped) used.push_back(&r);
   }
+  const FrameReport empty_report;
+  const FrameReport& final_report = used.empty() ? empty_report : *used.back();
+  double settle_deg = 0;
+  for (size_t k = used.size() >= 3 ? used.size() - 3 : 0; k < used.size(); ++k) {
+    settle_deg = std::max(settle_deg, RotationErrorDeg(used[k]->after.T_camera_lidar.linear(),
+                                                       outcome->estimate.T_camera_lidar.linear()));
+  }
+  const int skipped = static_cast<int>(outcome->reports.size() - used.size());
   const int points = final_report.points;
   const double moved_deg =
       RotationErrorDeg(outcome->estimate.T_camera_lidar.linear(), initial.T_camera_lidar.linear());
   const bool at_time_bound =
       std::abs(outcome->estimate.time_offset_s) >= job.online.time_offset_bound_s - 0.0025;
   const bool at_rotation_bound = moved_deg >= job.online.search.max_rotation_offset_deg - 0.5;
-  if (points < 30) {
+  if (used.empty()) {
+    outcome->reason = "not converged: all " + std::to_string(skipped) +
+                      " frames were skipped (first reason: " + outcome->reports.front().reason +
+                      ")";
+  } else if (points < 30) {
     outcome->reason = "not converged: no usable features (" + std::to_string(points) +
                       " LiDAR edge points in the image)";
-  } else if (static_cast<int>(outcome->reports.size()) < 3) {
-    outcome->reason = "not converged: " + std::to_string(outcome->reports.size()) +
-                      " frame(s) cannot show that the estimate has settled (3 needed)";
+  } else if (static_cast<int>(used.size()) < 3) {
+    outcome->reason = "not converged: " + std::to_string(used.size()) +
+                      " usable frame(s) cannot show that the estimate has settled (3 needed)";
   } else if (at_time_bound || at_rotation_bound) {
     outcome->reason =
         std::string("not converged: the estimate ran to the bound of its ") +
@@ -308,7 +325,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"score", final_report.score_after.score},
       {"gray_rate", final_report.gray_rate_after},
       {"health", final_report.health},
-      {"frames", {{"first", first}, {"last", last}}},
+      {"frames", {{"first", first}, {"last", last}, {"used", frames_used}, {"skipped", skipped}}},
       {"timing_ms",
        {{"per_frame_mean", outcome->mean_frame_ms},
         {"search_mean", search_ms},
@@ -377,15 +394,19 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
                 xs, {{"delta", dt_ms, cv::Scalar(0, 120, 200)}})};
   cv::Mat convergence;
   cv::vconcat(panels, convergence);
-  cv::Mat image;
-  status = drive.LoadImage(last_frame->index, &image);
-  if (!status.ok()) return fail(status);
-  for (const auto& [name, picture] : std::vector<std::pair<std::string, cv::Mat>>{
-           {"overlay_before.png",
-            DrawEdgeOverlay(image, *last_frame, outcome->initial, "before: initial calibration")},
-           {"overlay_after.png",
-            DrawEdgeOverlay(image, *last_frame, outcome->estimate, "after: estimate")},
-           {"convergence.png", convergence}}) {
+  std::vector<std::pair<std::string, cv::Mat>> pictures = {{"convergence.png", convergence}};
+  if (last_frame) {  // overlays on the last frame that was used
+    cv::Mat image;
+    status = drive.LoadImage(last_frame->index, &image);
+    if (!status.ok()) return fail(status);
+    pictures.emplace_back(
+        "overlay_before.png",
+        DrawEdgeOverlay(image, *last_frame, outcome->initial, "before: initial calibration"));
+    pictures.emplace_back(
+        "overlay_after.png",
+        DrawEdgeOverlay(image, *last_frame, outcome->estimate, "after: estimate"));
+  }
+  for (const auto& [name, picture] : pictures) {
     status = WriteImage(out + "/" + name, picture);
     if (!status.ok()) return fail(status);
     outcome->pictures.push_back(out + "/" + name);

@@ -5,10 +5,14 @@
 
 #include <array>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/io/image.h"
 #include "test/test_util.h"
@@ -188,6 +192,102 @@ TEST(Cli, CheckHoldsForKittiCalibrationAndCatchesOneDegreeOff) {
   EXPECT_THAT(off.output, HasSubstr("the calibration is off"));
   EXPECT_EQ(RunStcalib("check").exit_code, 2);
   EXPECT_EQ(RunStcalib("check --drive=" + tmp.path() + "/absent").exit_code, 1);
+}
+
+// Replaces line `index` (0-based) of a text file; `text` empty removes it.
+void EditLine(const std::string& path, size_t index, const std::string* text) {
+  std::istringstream in(testing::ReadFile(path));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  ASSERT_LT(index, lines.size()) << path;
+  if (text == nullptr) {
+    lines.erase(lines.begin() + static_cast<long>(index));
+  } else {
+    lines[index] = *text;
+  }
+  std::string out;
+  for (const std::string& line : lines) out += line + "\n";
+  testing::WriteFile(path, out);
+}
+
+TEST(Cli, CalibrateSkipsFaultyFramesKeepsTheEstimateAndRecovers) {
+  testing::ScopedTempDir tmp;
+  ASSERT_EQ(
+      RunStcalib("simulate --out=" + tmp.path() + " --frames=16 --seed=2 --time_offset_s=0.02")
+          .exit_code,
+      0);
+  std::string drive;
+  for (const auto& day : std::filesystem::directory_iterator(tmp.path())) {
+    for (const auto& d : std::filesystem::directory_iterator(day.path())) {
+      if (d.is_directory()) drive = d.path().string();
+    }
+  }
+  ASSERT_FALSE(drive.empty());
+  // Frame 4: a burst of NaN points.
+  {
+    const std::string path = drive + "/velodyne_points/data/0000000004.bin";
+    std::string bytes = testing::ReadFile(path);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (size_t k = 0; k < 4000 && (k + 1) * sizeof(float) <= bytes.size(); ++k) {
+      std::memcpy(&bytes[k * sizeof(float)], &nan, sizeof(float));
+    }
+    testing::WriteFile(path, bytes);
+  }
+  // Frame 6: a black image.
+  {
+    const std::string path = drive + "/image_02/data/0000000006.png";
+    cv::Mat image;
+    ASSERT_TRUE(ReadImage(path, &image).ok());
+    image.setTo(cv::Scalar::all(0));
+    ASSERT_TRUE(WriteImage(path, image).ok());
+  }
+  // Frame 8: the image stamp of frame 7 again.
+  {
+    const std::string path = drive + "/image_02/timestamps.txt";
+    std::istringstream in(testing::ReadFile(path));
+    std::string line;
+    for (int k = 0; k <= 7; ++k) std::getline(in, line);
+    EditLine(path, 8, &line);
+  }
+  // Frames 10-12: the oxts receiver stalls (packets 11 and 12 repeat the stamp of packet 10).
+  {
+    const std::string path = drive + "/oxts/timestamps.txt";
+    std::istringstream in(testing::ReadFile(path));
+    std::string line;
+    for (int k = 0; k <= 10; ++k) std::getline(in, line);
+    EditLine(path, 11, &line);
+    EditLine(path, 12, &line);
+  }
+  // Frame 14 dropped from every stream.
+  for (const auto& [folder, ext] : std::vector<std::pair<std::string, std::string>>{
+           {"image_02", ".png"}, {"velodyne_points", ".bin"}, {"oxts", ".txt"}}) {
+    std::filesystem::remove(drive + "/" + folder + "/data/0000000014" + ext);
+    for (const char* stamps : {"timestamps.txt", "timestamps_start.txt", "timestamps_end.txt"}) {
+      const std::string path = drive + "/" + folder + "/" + stamps;
+      if (std::filesystem::exists(path)) EditLine(path, 14, nullptr);
+    }
+  }
+  std::filesystem::remove(drive + "/velodyne_points/labels/0000000014.bin");
+
+  const std::string out = tmp.path() + "/out";
+  const RunResult r =
+      RunStcalib("calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" + drive +
+                 " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=2 --out=" + out);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const std::string csv = testing::ReadFile(out + "/per_frame.csv");
+  EXPECT_THAT(csv, HasSubstr("4,0,"));
+  EXPECT_THAT(csv, HasSubstr("0000000004.bin: point 0 has a NaN"));
+  EXPECT_THAT(csv, HasSubstr("frame skipped: no image edges"));
+  EXPECT_THAT(csv, HasSubstr("frame skipped: image stamp not after the previous frame's"));
+  for (int frame : {10, 11, 12}) {
+    EXPECT_THAT(csv, HasSubstr("oxts: frame " + std::to_string(frame) + " falls in a gap"));
+  }
+  const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
+  EXPECT_EQ(result["frames"]["skipped"].get<int>(), 6);
+  EXPECT_TRUE(result["converged"].get<bool>());
+  // The estimate after the faults is as good as the drive allows: well inside the 3.5° start.
+  EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.5);
+  EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.015);
 }
 
 TEST(Cli, EvalTemporalBadInput) {

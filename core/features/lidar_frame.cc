@@ -120,7 +120,14 @@ Status SweepCache::References(size_t frame, std::vector<ReferenceFeatures>* refe
   for (size_t gap : {size_t{1}, back}) {
     if (gap > frame || (gap == back && back == 1 && !references->empty())) continue;
     const LidarFrameFeatures* reference;
-    STCALIB_RETURN_IF_ERROR(Base(frame - gap, &reference));
+    const Status status = Base(frame - gap, &reference);
+    if (!status.ok() || !(reference->stamp_s < current->stamp_s)) {
+      // A dropped, unreadable or mis-stamped earlier sweep: compare with the others only.
+      LOG(WARNING) << "dynamic filter of frame " << frame << ": reference sweep " << frame - gap
+                   << " left out: "
+                   << (status.ok() ? "its stamp is not before this sweep's" : status.message());
+      continue;
+    }
     ReferenceFeatures r;
     r.features = reference;
     r.T_current_reference =
@@ -187,13 +194,22 @@ Status SweepCache::LocalMap(size_t frame, const LocalMapOptions& map_options, Li
   *stats = LocalMapStats();
   const size_t first =
       frame + 1 >= static_cast<size_t>(map_options.sweeps) ? frame + 1 - map_options.sweeps : 0;
+  const LidarFrameFeatures* current_features;
+  STCALIB_RETURN_IF_ERROR(Finished(frame, &current_features));
+  const LidarFrameFeatures& current = *current_features;
   std::vector<const LidarFrameFeatures*> sweeps;
-  for (size_t k = first; k <= frame; ++k) {
+  for (size_t k = first; k < frame; ++k) {
     const LidarFrameFeatures* f;
-    STCALIB_RETURN_IF_ERROR(Finished(k, &f));
+    const Status status = Finished(k, &f);
+    if (!status.ok() || !(f->stamp_s < current.stamp_s)) {
+      // A dropped, unreadable or mis-stamped earlier sweep: the map is built without it.
+      LOG(WARNING) << "local map of frame " << frame << ": sweep " << k << " left out: "
+                   << (status.ok() ? "its stamp is not before this sweep's" : status.message());
+      continue;
+    }
     sweeps.push_back(f);
   }
-  const LidarFrameFeatures& current = *sweeps.back();
+  sweeps.push_back(current_features);
   std::vector<std::pair<const LidarEdges*, Rigid3d>> previous;
   for (size_t k = 0; k + 1 < sweeps.size(); ++k) {
     Rigid3d T = RelativeLidarPose(motion_.PoseFunction(), current.stamp_s, sweeps[k]->stamp_s);

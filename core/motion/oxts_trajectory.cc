@@ -1,7 +1,10 @@
 #include "core/motion/oxts_trajectory.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace stcalib {
 
@@ -16,12 +19,14 @@ Status OxtsTrajectory::Create(const std::vector<OxtsPacket>& packets,
   t.reference_ns_ = stamps_ns.front();
   const OxtsOrigin origin{packets.front().lat, packets.front().lon, packets.front().alt};
   for (size_t i = 0; i < packets.size(); ++i) {
-    if (i > 0 && stamps_ns[i] <= stamps_ns[i - 1]) {
-      return Status::Error("oxts: stamp of packet " + std::to_string(i) +
-                           " does not increase (duplicated or out-of-order oxts stamps)");
+    const double time_s = NsToSeconds(stamps_ns[i] - t.reference_ns_);
+    if (!t.times_s_.empty() && time_s <= t.times_s_.back()) {
+      LOG(WARNING) << "oxts: packet " << i
+                   << " skipped: its stamp does not increase (duplicated or out of order)";
+      continue;
     }
     const OxtsPacket& p = packets[i];
-    t.times_s_.push_back(NsToSeconds(stamps_ns[i] - t.reference_ns_));
+    t.times_s_.push_back(time_s);
     t.poses_.push_back(OxtsPose(origin, p));
     const double c = std::cos(p.yaw), s = std::sin(p.yaw);
     t.velocities_world_.emplace_back(c * p.vf - s * p.vl, s * p.vf + c * p.vl, p.vu);
@@ -29,6 +34,14 @@ Status OxtsTrajectory::Create(const std::vector<OxtsPacket>& packets,
   }
   *trajectory = std::move(t);
   return Status::Ok();
+}
+
+double OxtsTrajectory::GapAround(double t) const {
+  if (times_s_.empty()) return std::numeric_limits<double>::infinity();
+  if (t <= times_s_.front()) return times_s_.front() - t;
+  if (t >= times_s_.back()) return t - times_s_.back();
+  const size_t i = std::upper_bound(times_s_.begin(), times_s_.end(), t) - times_s_.begin() - 1;
+  return times_s_[i + 1] - times_s_[i];
 }
 
 Rigid3d OxtsTrajectory::T_world_imu(StampNs stamp_ns) const {

@@ -16,7 +16,8 @@ namespace stcalib {
 // extrapolated with that packet's velocity and body rates.
 class OxtsTrajectory {
  public:
-  // Stamps must increase strictly; errors name the offending packet.
+  // A packet whose stamp does not increase (duplicated or out of order) is skipped with a
+  // warning; fewer than one usable packet is an error.
   static Status Create(const std::vector<OxtsPacket>& packets,
                        const std::vector<StampNs>& stamps_ns, OxtsTrajectory* trajectory);
 
@@ -24,6 +25,9 @@ class OxtsTrajectory {
   Rigid3d T_world_imu_s(double seconds_since_reference) const;
   StampNs reference_ns() const { return reference_ns_; }
   size_t size() const { return times_s_.size(); }
+  // The span between the packets around t [s], or to the nearest packet when t is outside them:
+  // how far the pose at t is interpolated or extrapolated.
+  double GapAround(double seconds_since_reference) const;
 
  private:
   StampNs reference_ns_ = 0;

@@ -24,6 +24,14 @@ Status DriveFrameSource::Create(const Drive* drive, const FrameSourceOptions& op
 Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   STCALIB_RETURN_IF_ERROR(drive_->CheckFrame(frame));
   *out = CalibrationFrame();
+  const double camera_s = motion_.Seconds(drive_->camera_stamps_ns[frame]);
+  const double oxts_gap_s = motion_.trajectory().GapAround(camera_s);
+  if (oxts_gap_s > options_.max_oxts_gap_s) {
+    return Status::Error(drive_->drive_dir + "/oxts: frame " + std::to_string(frame) +
+                         " falls in a gap of " + std::to_string(oxts_gap_s) +
+                         " s between oxts packets (more than " +
+                         std::to_string(options_.max_oxts_gap_s) + " s): no motion model");
+  }
   out->index = static_cast<int>(frame);
   cv::Mat image;
   STCALIB_RETURN_IF_ERROR(drive_->LoadImage(frame, &image));
@@ -51,8 +59,8 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   out->kinds = std::move(map.kind);
 
   const double lidar_s = motion_.Seconds(drive_->lidar_stamps_ns[frame]);
-  const double camera_s = motion_.Seconds(drive_->camera_stamps_ns[frame]);
   out->e0_s = lidar_s - camera_s;
+  out->camera_time_s = camera_s;
   out->twist = TwistFromPoses(motion_.PoseFunction(), camera_s);
   return Status::Ok();
 }

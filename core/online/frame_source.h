@@ -17,6 +17,9 @@ struct FrameSourceOptions {
   LocalMapOptions local_map;
   bool suppress_texture = false;  ///< score maps are the texture-suppressed IDTs
   bool oriented_maps = true;      ///< vertical/horizontal LiDAR edges read their own maps
+  // A frame whose image time lies in a longer gap between oxts packets (or further from the
+  // nearest one) is refused: its motion model would be a guess [s].
+  double max_oxts_gap_s = 0.25;
 
   FrameSourceOptions() {
     image.pyramid_basins_px = {60, 30};

@@ -54,7 +54,31 @@ std::vector<const CalibrationFrame*> OnlineCalibrator::SearchWindow() const {
   return frames;
 }
 
+FrameReport OnlineCalibrator::SkipFrame(int frame, const std::string& why) const {
+  FrameReport report;
+  report.frame = frame;
+  report.before = report.after = state_;
+  report.skipped = true;
+  report.reason = "frame skipped: " + why + "; estimate kept";
+  LOG(WARNING) << "frame " << frame << " skipped: " << why;
+  return report;
+}
+
 FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> frame) {
+  std::string why;
+  const bool finite_motion = std::isfinite(frame->e0_s) && std::isfinite(frame->camera_time_s) &&
+                             frame->twist.linear_m_s.allFinite() &&
+                             frame->twist.angular_rad_s.allFinite();
+  if (!finite_motion) {
+    why = "non-finite stamp gap or motion";
+  } else if (!(frame->camera_time_s > last_camera_time_s_)) {
+    why = "image stamp not after the previous frame's (duplicated or out of order)";
+  } else if (frame->image.empty() || frame->distance_px[0].empty() ||
+             frame->distance_px[1].empty()) {
+    why = "no image edges (black, blank or unreadable image)";
+  }
+  if (!why.empty()) return SkipFrame(frame->index, why);
+  last_camera_time_s_ = frame->camera_time_s;
   FrameReport report;
   report.frame = frame->index;
   report.before = state_;

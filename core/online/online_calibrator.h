@@ -1,6 +1,7 @@
 #pragma once
 
 #include <deque>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -39,7 +40,8 @@ struct FrameReport {
   int frame = 0;
   CalibrationState before, after;
   bool accepted = false;
-  std::string reason;                                ///< why the update was (not) taken
+  bool skipped = false;  ///< the frame was refused (bad data): nothing changed, see `reason`
+  std::string reason;    ///< why the update was (not) taken
   ScoreValue score_before, score_after;              ///< on the finest score map
   double gray_rate_before = 0, gray_rate_after = 0;  ///< on the plain IDT
   double health_before = 0;                          ///< method.md §7, at `before`
@@ -59,7 +61,11 @@ class OnlineCalibrator {
  public:
   OnlineCalibrator(const OnlineCalibratorOptions& options, const CalibrationState& initial);
 
+  // A frame that cannot be used (stamp not after the last frame's, no image edges, non-finite
+  // motion) is refused: the report says why and the estimate and window stay as they were.
   FrameReport AddFrame(std::shared_ptr<const CalibrationFrame> frame);
+  // A frame the caller could not load: recorded as skipped with `why`.
+  FrameReport SkipFrame(int frame, const std::string& why) const;
   const CalibrationState& state() const { return state_; }
   // Replaces the estimate (the paper's disturbance protocol); the bounds stay where they were.
   void SetState(const CalibrationState& state) { state_ = state; }
@@ -71,6 +77,7 @@ class OnlineCalibrator {
   CalibrationState state_;
   CalibrationState anchor_;  ///< the initial calibration: the search's bounds are around it
   std::deque<std::shared_ptr<const CalibrationFrame>> window_;  // the last refine_frames frames
+  double last_camera_time_s_ = -std::numeric_limits<double>::infinity();
 };
 
 }  // namespace stcalib

@@ -14,10 +14,11 @@ namespace stcalib {
 
 // One image with its LiDAR edge points: everything the score, the search and the refinement read.
 struct CalibrationFrame {
-  int index = 0;       ///< frame of the drive
-  double e0_s = 0;     ///< LiDAR stamp − camera stamp [s]; the gap is e = e0 + δ
-  LidarTwist twist;    ///< LiDAR body twist at the image time (motion model, method.md §3)
-  CameraModel camera;  ///< size read from the image
+  int index = 0;             ///< frame of the drive
+  double e0_s = 0;           ///< LiDAR stamp − camera stamp [s]; the gap is e = e0 + δ
+  double camera_time_s = 0;  ///< image stamp on the drive's clock [s] (frames must advance)
+  LidarTwist twist;          ///< LiDAR body twist at the image time (motion model, method.md §3)
+  CameraModel camera;        ///< size read from the image
   std::vector<Eigen::Vector3d> points_lidar;  ///< edge points (local map), at the LiDAR stamp
   std::vector<EdgeKind> kinds;
   ImageFeatures image;  ///< distance_raw_px for overlays
