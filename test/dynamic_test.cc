@@ -57,14 +57,22 @@ TEST(OxtsTrajectory, RelativePosesMatchTheSimulatedTruth) {
   }
 }
 
-TEST(OxtsTrajectory, RejectsBadStamps) {
-  std::vector<OxtsPacket> packets(3);
+TEST(OxtsTrajectory, SkipsStalePacketsAndReportsGaps) {
+  std::vector<OxtsPacket> packets(4);
   OxtsTrajectory trajectory;
-  EXPECT_FALSE(OxtsTrajectory::Create(packets, {1, 2, 2}, &trajectory).ok());
-  EXPECT_FALSE(OxtsTrajectory::Create(packets, {3, 2, 4}, &trajectory).ok());
   EXPECT_FALSE(OxtsTrajectory::Create(packets, {1, 2}, &trajectory).ok());
   EXPECT_FALSE(OxtsTrajectory::Create({}, {}, &trajectory).ok());
-  EXPECT_TRUE(OxtsTrajectory::Create(packets, {1, 2, 3}, &trajectory).ok());
+  // Packet 2 repeats packet 1's stamp, packet 3 goes back: both skipped.
+  const int64_t s = 1000000000;  // 1 s in ns
+  ASSERT_TRUE(OxtsTrajectory::Create(packets, {0, s / 10, s / 10, s / 20}, &trajectory).ok());
+  EXPECT_EQ(trajectory.size(), 2u);
+  ASSERT_TRUE(
+      OxtsTrajectory::Create(packets, {0, s / 10, 4 * s / 10, 5 * s / 10}, &trajectory).ok());
+  EXPECT_EQ(trajectory.size(), 4u);
+  EXPECT_NEAR(trajectory.GapAround(0.05), 0.1, 1e-9);
+  EXPECT_NEAR(trajectory.GapAround(0.2), 0.3, 1e-9);   // inside the stall
+  EXPECT_NEAR(trajectory.GapAround(0.7), 0.2, 1e-9);   // beyond the last packet
+  EXPECT_NEAR(trajectory.GapAround(-0.1), 0.1, 1e-9);  // before the first
 }
 
 TEST(Deskew, PureTranslationMovesEachPointByItsOwnTime) {
