@@ -69,9 +69,9 @@ TEST(KittiReaders, CalibrationFilesHoldKnownValues) {
 
   Rigid3d T_camera_lidar;
   ASSERT_TRUE(ReadVeloToCam(KittiCalibDir() + "/calib_velo_to_cam.txt", &T_camera_lidar).ok());
-  EXPECT_DOUBLE_EQ(T_camera_lidar(0, 0), 7.533745e-03);
-  EXPECT_DOUBLE_EQ(T_camera_lidar(0, 1), -9.999714e-01);
-  EXPECT_DOUBLE_EQ(T_camera_lidar(2, 0), 9.998621e-01);
+  EXPECT_NEAR(T_camera_lidar(0, 0), 7.533745e-03, 1e-6);   // R moved to the nearest rotation
+  EXPECT_NEAR(T_camera_lidar(0, 1), -9.999714e-01, 1e-6);  // R moved to the nearest rotation
+  EXPECT_NEAR(T_camera_lidar(2, 0), 9.998621e-01, 1e-6);   // R moved to the nearest rotation
   EXPECT_DOUBLE_EQ(T_camera_lidar(0, 3), -4.069766e-03);
   EXPECT_DOUBLE_EQ(T_camera_lidar(1, 3), -7.631618e-02);
   EXPECT_DOUBLE_EQ(T_camera_lidar(2, 3), -2.717806e-01);
@@ -79,7 +79,7 @@ TEST(KittiReaders, CalibrationFilesHoldKnownValues) {
   Rigid3d T_lidar_imu;
   ASSERT_TRUE(ReadImuToVelo(KittiCalibDir() + "/calib_imu_to_velo.txt", &T_lidar_imu).ok());
   EXPECT_DOUBLE_EQ(T_lidar_imu(0, 3), -8.086759e-01);
-  EXPECT_DOUBLE_EQ(T_lidar_imu(1, 2), -1.482298e-02);
+  EXPECT_NEAR(T_lidar_imu(1, 2), -1.482298e-02, 1e-6);  // R moved to the nearest rotation
 }
 
 TEST(KittiReaders, DriveIndexesThirtyFramesWithMonotonicStamps) {

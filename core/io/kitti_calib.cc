@@ -29,7 +29,7 @@ Status ReadRigid(const std::string& path, Rigid3d* T) {
   STCALIB_RETURN_IF_ERROR(file.GetMatrix("R", 3, 3, &R));
   STCALIB_RETURN_IF_ERROR(file.GetMatrix("T", 3, 1, &t));
   STCALIB_RETURN_IF_ERROR(CheckRotation(R, path + ": key 'R'"));
-  *T = MakeRigid(R, t);
+  *T = MakeRigid(NearestRotation(R), t);
   return Status::Ok();
 }
 
@@ -151,7 +151,7 @@ Status CheckRotation(const Eigen::Matrix3d& rotation, const std::string& what) {
   const double orthogonality =
       (rotation * rotation.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   const double det = rotation.determinant();
-  if (orthogonality > 1e-3 || std::abs(det - 1.0) > 1e-3) {
+  if (orthogonality > kRotationTolerance || std::abs(det - 1.0) > kRotationTolerance) {
     return Status::Error(what + " is not a rotation matrix (|R·Rᵀ − I| = " +
                          std::to_string(orthogonality) + ", det = " + std::to_string(det) + ")");
   }

@@ -52,7 +52,8 @@ struct CameraCalibration {
 
 Status ReadCamToCam(const std::string& path, CameraCalibration* calibration);
 
-// calib_velo_to_cam.txt: R (9) and T (3) of T_camera_lidar (LiDAR to unrectified camera 0).
+// calib_velo_to_cam.txt: R (9) and T (3) of T_camera_lidar (LiDAR to unrectified camera 0); R
+// is replaced by the nearest rotation.
 Status ReadVeloToCam(const std::string& path, Rigid3d* T_camera_lidar);
 // Writes R, T (and KITTI's delta_f / delta_c, zero) with 12 significant digits.
 Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar);
@@ -61,7 +62,11 @@ Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar);
 Status ReadImuToVelo(const std::string& path, Rigid3d* T_lidar_imu);
 Status WriteImuToVelo(const std::string& path, const Rigid3d& T_lidar_imu);
 
-// Checks that a 3x3 matrix read from `what` is a rotation (orthonormal, det +1, to 1e-3).
+// Checks that a 3x3 matrix read from `what` is a rotation: orthonormal and det +1 to within
+// kRotationTolerance (largest entry of R·Rᵀ − I). Files print ~7 digits (KITTI's rotations are
+// ~1e-7 from orthonormal); the rigid transforms (velo_to_cam, imu_to_velo) are then moved to the
+// nearest exact rotation, so that nothing downstream works with a slightly skewed matrix.
+constexpr double kRotationTolerance = 1e-3;
 Status CheckRotation(const Eigen::Matrix3d& rotation, const std::string& what);
 
 }  // namespace stcalib

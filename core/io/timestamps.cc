@@ -91,8 +91,9 @@ bool ParseKittiTimestamp(const std::string& raw, StampNs* stamp_ns) {
     if (digits == 0 || pos != text.size()) return false;
     for (; digits < 9; ++digits) fraction_ns *= 10;
   }
-  if (month < 1 || month > 12 || day < 1 || day > DaysInMonth(year, month) || hour > 23 ||
-      minute > 59 || second > 60) {
+  // Nanoseconds since 1970 in an int64 reach 1677..2262; years outside 1900..2200 are typos.
+  if (year < 1900 || year > 2200 || month < 1 || month > 12 || day < 1 ||
+      day > DaysInMonth(year, month) || hour > 23 || minute > 59 || second > 60) {
     return false;
   }
   const int64_t seconds =

@@ -15,7 +15,8 @@ using StampNs = int64_t;
 inline double NsToSeconds(int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 inline int64_t SecondsToNs(double s) { return static_cast<int64_t>(std::llround(s * 1e9)); }
 
-// Parses "YYYY-MM-DD HH:MM:SS.nnnnnnnnn" (1–9 fraction digits). False on any malformation.
+// Parses "YYYY-MM-DD HH:MM:SS.nnnnnnnnn" (1–9 fraction digits, years 1900–2200). False on any
+// malformation.
 bool ParseKittiTimestamp(const std::string& text, StampNs* stamp_ns);
 
 // Formats as "YYYY-MM-DD HH:MM:SS.nnnnnnnnn" (always 9 fraction digits).

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 namespace stcalib {
 
@@ -21,6 +22,16 @@ inline Eigen::Matrix3d ExpSO3(const Eigen::Vector3d& rotation_vector_rad) {
   const double angle = rotation_vector_rad.norm();
   if (angle < 1e-12) return Eigen::Matrix3d::Identity();
   return Eigen::AngleAxisd(angle, rotation_vector_rad / angle).toRotationMatrix();
+}
+
+// The rotation nearest to `m` in the Frobenius norm (U·Vᵀ of its SVD, with the sign that keeps
+// det = +1). Calibration files print rotations to a few digits, so they are not exactly
+// orthonormal.
+inline Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& m) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  return svd.matrixU() * d * svd.matrixV().transpose();
 }
 
 // Axis-angle vector of a rotation matrix (logarithm map of SO(3)), angle in [0, pi].
