@@ -234,6 +234,13 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const TimeOffsetProfile profile =
       ProfileTimeOffset(&scorer, outcome->estimate, job.online.time_offset_bound_s, 0.0025);
   outcome->alias_suspect = profile.alias_suspect;
+  std::array<RotationAxisProfile, 3> axis_profiles;
+  for (int axis = 0; axis < 3; ++axis) {
+    axis_profiles[axis] = ProfileRotationAxis(&scorer, outcome->estimate, axis);
+    VLOG(1) << kAxisNames[axis] << " profile: best " << axis_profiles[axis].best_deg << " second "
+            << axis_profiles[axis].second_peak_deg << " ratio "
+            << axis_profiles[axis].second_peak_ratio;
+  }
 
   // Convergence: the last used frame's health is high and the estimate has settled over the
   // last three used frames (skipped frames say nothing).
@@ -250,11 +257,50 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   }
   const int skipped = static_cast<int>(outcome->reports.size() - used.size());
   const int points = final_report.points;
+  // Axes the last refinement could not pin down (std above the thresholds): they were held, so
+  // their values say nothing about the data.
+  std::vector<std::string> unobservable;
+  for (int k = 0; k < kNumAxes; ++k) {
+    if (k == 6 && !job.online.refine.estimate_time_offset) continue;
+    if (!final_report.refine.observable[k]) unobservable.push_back(kAxisNames[k]);
+  }
+  std::string unobservable_text;
+  for (const std::string& axis : unobservable) {
+    unobservable_text += (unobservable_text.empty() ? "" : ", ") + axis;
+  }
   const double moved_deg =
       RotationErrorDeg(outcome->estimate.T_camera_lidar.linear(), initial.T_camera_lidar.linear());
   const bool at_time_bound =
       std::abs(outcome->estimate.time_offset_s) >= job.online.time_offset_bound_s - 0.0025;
   const bool at_rotation_bound = moved_deg >= job.online.search.max_rotation_offset_deg - 0.5;
+  if (!used.empty() && !unobservable.empty()) {
+    // Values the data cannot pin down carry no information from this drive: they go back to the
+    // start (earlier frames may have moved them before their ambiguity showed).
+    outcome->estimate =
+        KeepObservableAxes(initial, outcome->estimate, final_report.refine.observable);
+    outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
+  }
+  // Along each rotation axis the score of the last frames must peak at the estimate, and only
+  // there: a peak elsewhere means the windows disagree, a second peak that the axis is ambiguous.
+  std::string profile_problem;
+  nlohmann::json profiles_json;
+  for (int axis = 0; axis < 3; ++axis) {
+    const RotationAxisProfile& p = axis_profiles[axis];
+    profiles_json[kAxisNames[axis]] = {{"best_offset_deg", p.best_deg},
+                                       {"second_peak_offset_deg", p.second_peak_deg},
+                                       {"second_peak_ratio", p.second_peak_ratio}};
+    char text[160] = "";
+    if (std::abs(p.best_deg) > 0.5) {
+      std::snprintf(text, sizeof(text), "the last frames' score peaks %+.2f deg away on %s",
+                    p.best_deg, kAxisNames[axis]);
+    } else if (p.ambiguous) {
+      std::snprintf(text, sizeof(text),
+                    "%s is ambiguous: a second score peak %+.2f deg away reaches %.0f%% of the "
+                    "best",
+                    kAxisNames[axis], p.second_peak_deg, 100 * p.second_peak_ratio);
+    }
+    if (text[0] != '\0' && profile_problem.empty()) profile_problem = text;
+  }
   if (used.empty()) {
     outcome->reason = "not converged: all " + std::to_string(skipped) +
                       " frames were skipped (first reason: " + outcome->reports.front().reason +
@@ -271,6 +317,11 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
         (at_time_bound ? "time offset (|δ| = bound)"
                        : "rotation search (moved " + std::to_string(moved_deg) + " deg)") +
         ": the score has no trustworthy optimum inside the bounds";
+  } else if (!unobservable.empty()) {
+    outcome->reason = "not converged: not observable in this drive: " + unobservable_text +
+                      " (held at their start values; the scene does not constrain them)";
+  } else if (!profile_problem.empty()) {
+    outcome->reason = "not converged: " + profile_problem;
   } else if (final_report.health < 0.8) {
     outcome->reason = "not converged: health " + std::to_string(final_report.health) +
                       " < 0.8 (the estimate is not a clear optimum of the score)";
@@ -316,6 +367,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"rpy_deg", {{"roll", rpy_deg.x()}, {"pitch", rpy_deg.y()}, {"yaw", rpy_deg.z()}}},
       {"std", std_json},
       {"observable", observable_json},
+      {"unobservable_axes", unobservable},
+      {"rotation_profiles", profiles_json},
       {"converged", outcome->converged},
       {"reason", outcome->reason},
       {"alias_suspect", outcome->alias_suspect},

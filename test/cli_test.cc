@@ -194,6 +194,16 @@ TEST(Cli, CheckHoldsForKittiCalibrationAndCatchesOneDegreeOff) {
   EXPECT_EQ(RunStcalib("check --drive=" + tmp.path() + "/absent").exit_code, 1);
 }
 
+// The simulated drive folder (DIR/<date>/<date>_drive_0001_sync) written by `simulate`.
+std::string SimulatedDrive(const std::string& out) {
+  for (const auto& day : std::filesystem::directory_iterator(out)) {
+    for (const auto& d : std::filesystem::directory_iterator(day.path())) {
+      if (d.is_directory()) return d.path().string();
+    }
+  }
+  return "";
+}
+
 // Replaces line `index` (0-based) of a text file; `text` empty removes it.
 void EditLine(const std::string& path, size_t index, const std::string* text) {
   std::istringstream in(testing::ReadFile(path));
@@ -216,12 +226,7 @@ TEST(Cli, CalibrateSkipsFaultyFramesKeepsTheEstimateAndRecovers) {
       RunStcalib("simulate --out=" + tmp.path() + " --frames=16 --seed=2 --time_offset_s=0.02")
           .exit_code,
       0);
-  std::string drive;
-  for (const auto& day : std::filesystem::directory_iterator(tmp.path())) {
-    for (const auto& d : std::filesystem::directory_iterator(day.path())) {
-      if (d.is_directory()) drive = d.path().string();
-    }
-  }
+  const std::string drive = SimulatedDrive(tmp.path());
   ASSERT_FALSE(drive.empty());
   // Frame 4: a burst of NaN points.
   {
@@ -288,6 +293,46 @@ TEST(Cli, CalibrateSkipsFaultyFramesKeepsTheEstimateAndRecovers) {
   // The estimate after the faults is as good as the drive allows: well inside the 3.5° start.
   EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.5);
   EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.015);
+}
+
+// Degenerate scenes (method.md §7): an open road (lane markings and kerbs only) leaves rotation
+// axes unobservable; a street of poles is ambiguous. The calibrator must say so, hold what it
+// cannot see, and never claim success with a wrong answer.
+TEST(Cli, DegenerateScenesAreReportedNeverAWrongSuccess) {
+  for (const std::string scene : {"open", "poles"}) {
+    SCOPED_TRACE(scene);
+    testing::ScopedTempDir tmp;
+    ASSERT_EQ(RunStcalib("simulate --out=" + tmp.path() + " --frames=12 --seed=4 --scene=" + scene +
+                         " --time_offset_s=0.02")
+                  .exit_code,
+              0);
+    const std::string out = tmp.path() + "/out";
+    const RunResult r =
+        RunStcalib("calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" +
+                   SimulatedDrive(tmp.path()) +
+                   " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=1 --out=" + out);
+    const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
+    const bool converged = result["converged"].get<bool>();
+    EXPECT_EQ(r.exit_code, converged ? 0 : 1) << r.output;
+    EXPECT_EQ(std::filesystem::exists(out + "/calib_velo_to_cam.txt"), converged);
+    if (converged) {  // success only with a right answer
+      EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.5) << r.output;
+    }
+    if (scene == "open") {
+      EXPECT_FALSE(converged);
+      const auto& unobservable = result["unobservable_axes"];
+      ASSERT_FALSE(unobservable.empty()) << r.output;
+      EXPECT_THAT(r.output, HasSubstr("not observable in this drive"));
+      // Held: an unobservable axis keeps its start value exactly.
+      for (const auto& axis : unobservable) {
+        const std::string name = axis.get<std::string>();
+        if (name == "time_offset_s" || name.find("_deg") == std::string::npos) continue;
+        EXPECT_NEAR(result["error"][name].get<double>(),
+                    result["initial_error"][name].get<double>(), 0.1)
+            << name;
+      }
+    }
+  }
 }
 
 TEST(Cli, EvalTemporalBadInput) {

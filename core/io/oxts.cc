@@ -40,7 +40,10 @@ Status ParseOxtsPacket(const std::string& line, const std::string& path, OxtsPac
     if (real != nullptr) {
       *real = v;
     } else {
-      if (v != std::floor(v) || std::abs(v) > 1e9) integral = false;
+      if (v != std::floor(v) || std::abs(v) > 1e9) {
+        integral = false;  // and never cast: out of int range is undefined behaviour
+        return;
+      }
       *integer = static_cast<int>(v);
     }
   });

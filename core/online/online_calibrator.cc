@@ -13,7 +13,8 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-// Keeps the observable axes of `candidate` and the old values of the others.
+}  // namespace
+
 CalibrationState KeepObservableAxes(const CalibrationState& old, const CalibrationState& candidate,
                                     const std::array<bool, kNumAxes>& observable) {
   const Eigen::Vector3d rotation =
@@ -27,8 +28,6 @@ CalibrationState KeepObservableAxes(const CalibrationState& old, const Calibrati
   }
   return Step(old, r, t, observable[6] ? candidate.time_offset_s - old.time_offset_s : 0.0);
 }
-
-}  // namespace
 
 Status OnlineCalibratorOptions::Validate() const {
   if (window_frames < 1) return Status::Error("online: window_frames must be >= 1");
@@ -133,7 +132,20 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
     candidates.emplace_back(
         KeepObservableAxes(state_, report.refine.state, report.refine.observable), "refined");
   }
-  candidates.emplace_back(report.search.state, "search");
+  // The search result too keeps the axes the refinement found unobservable where they were: a
+  // degenerate scene (open road, poles only) must not move what it cannot see.
+  bool all_observable = true;
+  for (int k = 0; k < kNumAxes; ++k) all_observable = all_observable && report.refine.observable[k];
+  if (report.refine.covariance_ok && !all_observable) {
+    std::string held;
+    for (int k = 0; k < kNumAxes; ++k) {
+      if (!report.refine.observable[k]) held += std::string(", held ") + kAxisNames[k];
+    }
+    candidates.emplace_back(
+        KeepObservableAxes(state_, report.search.state, report.refine.observable), "search" + held);
+  } else {
+    candidates.emplace_back(report.search.state, "search");
+  }
   report.after = state_;
   report.reason = "no candidate scored better: estimate kept";
   double best = before_long;
@@ -145,7 +157,7 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
     report.after = candidate;
     report.accepted = true;
     report.reason = name;
-    if (name == "refined") {
+    if (name.rfind("refined", 0) == 0) {
       for (int k = 0; k < kNumAxes; ++k) {
         if (!report.refine.observable[k]) report.reason += std::string(", held ") + kAxisNames[k];
       }

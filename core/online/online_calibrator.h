@@ -53,6 +53,11 @@ struct FrameReport {
   int points = 0;
 };
 
+// `candidate` on its observable axes, `old` on the others (rotation about the LiDAR axes,
+// translation, time offset, in kAxisNames order).
+CalibrationState KeepObservableAxes(const CalibrationState& old, const CalibrationState& candidate,
+                                    const std::array<bool, kNumAxes>& observable);
+
 // Online calibration (method.md §7): frames in time order; per frame a search step and a refine
 // over the window; an update is taken only when the window score does not get worse and the axes
 // it moves are observable (an unobservable axis keeps its value); |δ| stays within its bound.

@@ -162,6 +162,37 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
   return result;
 }
 
+namespace {
+
+// Best and second local maximum (at least min_separation away) of a 1-D score profile.
+struct PeakStats {
+  size_t best = 0;
+  size_t second = 0;
+  double ratio = 0;  // (second − floor) / (best − floor)
+};
+PeakStats FindPeaks(const std::vector<double>& offsets, const std::vector<double>& scores,
+                    double min_separation) {
+  PeakStats stats;
+  if (scores.empty()) return stats;
+  stats.best = std::max_element(scores.begin(), scores.end()) - scores.begin();
+  const double floor = *std::min_element(scores.begin(), scores.end());
+  double second = floor;
+  for (size_t i = 0; i < scores.size(); ++i) {
+    const bool peak = (i == 0 || scores[i] >= scores[i - 1]) &&
+                      (i + 1 == scores.size() || scores[i] >= scores[i + 1]);
+    if (!peak || std::abs(offsets[i] - offsets[stats.best]) < min_separation) continue;
+    if (scores[i] > second) {
+      second = scores[i];
+      stats.second = i;
+    }
+  }
+  const double range = scores[stats.best] - floor;
+  stats.ratio = range > 0 ? (second - floor) / range : 0.0;
+  return stats;
+}
+
+}  // namespace
+
 TimeOffsetProfile ProfileTimeOffset(WindowScorer* scorer, const CalibrationState& state,
                                     double bound_s, double step_s, double ratio,
                                     double min_separation_s) {
@@ -173,25 +204,32 @@ TimeOffsetProfile ProfileTimeOffset(WindowScorer* scorer, const CalibrationState
     profile.scores.push_back(scorer->Evaluate(s, -1).score);
   }
   if (profile.scores.empty()) return profile;
-  const auto best_it = std::max_element(profile.scores.begin(), profile.scores.end());
-  const size_t best = best_it - profile.scores.begin();
-  const double floor = *std::min_element(profile.scores.begin(), profile.scores.end());
-  profile.best_s = profile.offsets_s[best];
-  // Second local maximum far enough from the best.
-  double second = floor;
-  for (size_t i = 0; i < profile.scores.size(); ++i) {
-    const bool peak =
-        (i == 0 || profile.scores[i] >= profile.scores[i - 1]) &&
-        (i + 1 == profile.scores.size() || profile.scores[i] >= profile.scores[i + 1]);
-    if (!peak || std::abs(profile.offsets_s[i] - profile.best_s) < min_separation_s) continue;
-    if (profile.scores[i] > second) {
-      second = profile.scores[i];
-      profile.second_peak_s = profile.offsets_s[i];
-    }
-  }
-  const double range = profile.scores[best] - floor;
-  profile.second_peak_ratio = range > 0 ? (second - floor) / range : 0.0;
+  const PeakStats peaks = FindPeaks(profile.offsets_s, profile.scores, min_separation_s);
+  profile.best_s = profile.offsets_s[peaks.best];
+  profile.second_peak_s = profile.offsets_s[peaks.second];
+  profile.second_peak_ratio = peaks.ratio;
   profile.alias_suspect = profile.second_peak_ratio >= ratio;
+  return profile;
+}
+
+RotationAxisProfile ProfileRotationAxis(WindowScorer* scorer, const CalibrationState& state,
+                                        int axis, double half_range_deg, double step_deg,
+                                        double ratio, double min_separation_deg) {
+  CHECK(axis >= 0 && axis < 3) << "rotation axis " << axis;
+  RotationAxisProfile profile;
+  for (double d = -half_range_deg; d <= half_range_deg + 1e-9; d += step_deg) {
+    Eigen::Vector3d r = Eigen::Vector3d::Zero();
+    r[axis] = d * M_PI / 180.0;
+    profile.offsets_deg.push_back(d);
+    profile.scores.push_back(
+        scorer->Evaluate(Step(state, r, Eigen::Vector3d::Zero(), 0.0), -1).score);
+  }
+  if (profile.scores.empty()) return profile;
+  const PeakStats peaks = FindPeaks(profile.offsets_deg, profile.scores, min_separation_deg);
+  profile.best_deg = profile.offsets_deg[peaks.best];
+  profile.second_peak_deg = profile.offsets_deg[peaks.second];
+  profile.second_peak_ratio = peaks.ratio;
+  profile.ambiguous = profile.second_peak_ratio >= ratio;
   return profile;
 }
 

@@ -74,4 +74,20 @@ TimeOffsetProfile ProfileTimeOffset(WindowScorer* scorer, const CalibrationState
                                     double bound_s, double step_s, double ratio = 0.9,
                                     double min_separation_s = 0.01);
 
+// The same guard for a rotation axis (0 roll, 1 pitch, 2 yaw about the LiDAR axes): the score
+// along the axis within ±half_range_deg of `state`. Repetitive structure (signs on poles, window
+// rows) can give a second peak degrees away that scores about as well: then the axis is
+// ambiguous and the estimate may sit on the wrong peak.
+struct RotationAxisProfile {
+  std::vector<double> offsets_deg, scores;
+  double best_deg = 0;
+  double second_peak_deg = 0;
+  double second_peak_ratio = 0;  ///< (second − floor) / (best − floor)
+  bool ambiguous = false;
+};
+RotationAxisProfile ProfileRotationAxis(WindowScorer* scorer, const CalibrationState& state,
+                                        int axis, double half_range_deg = 4.0,
+                                        double step_deg = 0.25, double ratio = 0.9,
+                                        double min_separation_deg = 1.0);
+
 }  // namespace stcalib
