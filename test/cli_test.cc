@@ -295,6 +295,27 @@ TEST(Cli, CalibrateSkipsFaultyFramesKeepsTheEstimateAndRecovers) {
   EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.015);
 }
 
+// A drive without oxts/: the motion model comes from registering consecutive sweeps with a
+// constant velocity between them (method.md §3's fallback), and the calibration still works.
+TEST(Cli, CalibratesADriveWithoutOxtsFromScanRegistration) {
+  testing::ScopedTempDir tmp;
+  ASSERT_EQ(
+      RunStcalib("simulate --out=" + tmp.path() + " --frames=12 --seed=3 --time_offset_s=0.03")
+          .exit_code,
+      0);
+  const std::string drive = SimulatedDrive(tmp.path());
+  std::filesystem::remove_all(drive + "/oxts");
+  const std::string out = tmp.path() + "/out";
+  const RunResult r =
+      RunStcalib("calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" + drive +
+                 " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=3 --out=" + out);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("no oxts; the motion comes from registering consecutive sweeps"));
+  const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
+  EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.5) << r.output;
+  EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.01) << r.output;
+}
+
 // Degenerate scenes (method.md §7): an open road (lane markings and kerbs only) leaves rotation
 // axes unobservable; a street of poles is ambiguous. The calibrator must say so, hold what it
 // cannot see, and never claim success with a wrong answer.

@@ -7,6 +7,7 @@
 #include "core/features/lidar_frame.h"
 #include "core/motion/deskew.h"
 #include "core/motion/drive_motion.h"
+#include "core/motion/motion_model.h"
 #include "core/motion/oxts_trajectory.h"
 #include "core/score/alignment.h"
 #include "core/sim/simulator.h"
@@ -73,6 +74,42 @@ TEST(OxtsTrajectory, SkipsStalePacketsAndReportsGaps) {
   EXPECT_NEAR(trajectory.GapAround(0.2), 0.3, 1e-9);   // inside the stall
   EXPECT_NEAR(trajectory.GapAround(0.7), 0.2, 1e-9);   // beyond the last packet
   EXPECT_NEAR(trajectory.GapAround(-0.1), 0.1, 1e-9);  // before the first
+}
+
+// Without oxts the motion comes from registering consecutive sweeps (constant velocity between
+// them): it must follow the oxts motion, which sim_test checks against the simulated truth.
+TEST(DriveMotion, ScanRegistrationFollowsTheOxtsMotion) {
+  testing::ScopedTempDir tmp;
+  sim::SimulatorOptions options;
+  options.seed = 5;
+  options.frames = 8;
+  options.dynamic_objects = 0;
+  std::string drive_dir;
+  ASSERT_TRUE(sim::WriteSimulatedDrive(options, tmp.path(), &drive_dir).ok());
+  Drive drive;
+  ASSERT_TRUE(OpenDrive(drive_dir, "", &drive).ok());
+  DriveMotion oxts, scans;
+  ASSERT_TRUE(DriveMotion::Create(drive, &oxts).ok());
+  const Status status = DriveMotion::CreateFromScans(drive, &scans);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(scans.source(), DriveMotion::Source::kScanRegistration);
+  EXPECT_EQ(scans.failed_registrations(), 0);
+  auto relative = [&](const DriveMotion& m, StampNs a, StampNs b) {
+    return m.T_world_lidar(m.Seconds(a)).inverse() * m.T_world_lidar(m.Seconds(b));
+  };
+  for (size_t k = 1; k < drive.NumFrames(); ++k) {
+    const StampNs a = drive.lidar_stamps_ns[k - 1], b = drive.lidar_stamps_ns[k];
+    const Rigid3d truth = relative(oxts, a, b), estimate = relative(scans, a, b);
+    const Rigid3d error = truth.inverse() * estimate;
+    EXPECT_LT(error.translation().norm(), 0.05) << "sweep " << k;
+    EXPECT_LT(LogSO3(error.linear()).norm() * 180 / M_PI, 0.2) << "sweep " << k;
+    // Between stamps (the image time): the constant-velocity twist.
+    const double t_mid = 0.5 * (scans.Seconds(a) + scans.Seconds(b));
+    const LidarTwist twist_scans = TwistFromPoses(scans.PoseFunction(), t_mid);
+    const LidarTwist twist_oxts = TwistFromPoses(oxts.PoseFunction(), oxts.Seconds((a + b) / 2));
+    EXPECT_LT((twist_scans.linear_m_s - twist_oxts.linear_m_s).norm(), 0.5) << "sweep " << k;
+  }
+  EXPECT_DOUBLE_EQ(scans.GapAround(scans.Seconds(drive.lidar_stamps_ns[3])), 0.0);
 }
 
 TEST(Deskew, PureTranslationMovesEachPointByItsOwnTime) {

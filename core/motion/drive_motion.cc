@@ -1,5 +1,12 @@
 #include "core/motion/drive_motion.h"
 
+#include <glog/logging.h>
+
+#include <algorithm>
+
+#include "core/motion/motion_model.h"
+#include "core/pcl/registration.h"
+
 namespace stcalib {
 
 Status DriveMotion::Create(const Drive& drive, DriveMotion* motion) {
@@ -13,12 +20,97 @@ Status DriveMotion::Create(const Drive& drive, DriveMotion* motion) {
   STCALIB_RETURN_IF_ERROR(OxtsTrajectory::Create(drive.oxts, drive.oxts_stamps_ns, &m.trajectory_)
                               .WithContext(drive.drive_dir + "/oxts: "));
   m.T_imu_lidar_ = drive.T_lidar_imu.inverse();
+  m.source_ = Source::kOxts;
+  m.reference_ns_ = m.trajectory_.reference_ns();
+  *motion = std::move(m);
+  return Status::Ok();
+}
+
+Status DriveMotion::CreateFromScans(const Drive& drive, DriveMotion* motion) {
+  const size_t n = drive.NumFrames();
+  if (n < 2) return Status::Error(drive.drive_dir + ": scan registration needs two sweeps or more");
+  DriveMotion m;
+  m.source_ = Source::kScanRegistration;
+  m.reference_ns_ = drive.lidar_stamps_ns.front();
+  // Points between 2 and 60 m: the near car body and the sparse far field only add noise.
+  auto load = [&](size_t k, std::vector<Eigen::Vector3d>* points) -> Status {
+    LidarScan scan;
+    STCALIB_RETURN_IF_ERROR(drive.LoadScan(k, &scan));
+    points->clear();
+    for (const Eigen::Vector3d& p : scan.points_lidar) {
+      const double r = p.norm();
+      if (r > 2.0 && r < 60.0) points->push_back(p);
+    }
+    if (points->size() < 1000) return Status::Error(drive.VelodynePath(k) + ": too few points");
+    return Status::Ok();
+  };
+  std::vector<Eigen::Vector3d> previous, current;
+  bool have_previous = false;
+  Rigid3d T_world = Rigid3d::Identity();
+  Rigid3d T_previous_current_guess = Rigid3d::Identity();
+  double last_dt = 0.1;
+  for (size_t k = 0; k < n; ++k) {
+    const double t = NsToSeconds(drive.lidar_stamps_ns[k] - m.reference_ns_);
+    if (!m.scan_times_s_.empty() && !(t > m.scan_times_s_.back())) {
+      LOG(WARNING) << drive.drive_dir << ": sweep " << k
+                   << " left out of the motion: its stamp does not increase";
+      continue;
+    }
+    const Status status = load(k, &current);
+    if (!status.ok()) {
+      LOG(WARNING) << "scan motion: sweep " << k << " left out: " << status.message();
+      continue;
+    }
+    if (have_previous) {
+      const double dt = t - m.scan_times_s_.back();
+      // Constant-velocity guess from the last segment, scaled to this gap.
+      const LidarTwist guess_twist = ConstantVelocityTwist(T_previous_current_guess, last_dt);
+      RegistrationResult result;
+      const Status registered =
+          RegisterNdt(current, previous, LidarMotion(guess_twist, dt), NdtOptions(), &result);
+      Rigid3d T_previous_current = LidarMotion(guess_twist, dt);
+      const bool plausible = registered.ok() && result.T_target_source.matrix().allFinite() &&
+                             result.T_target_source.translation().norm() < 60.0 * dt + 0.5;
+      if (plausible) {
+        T_previous_current = result.T_target_source;
+      } else {
+        ++m.failed_registrations_;
+        LOG(WARNING) << "scan motion: sweep " << k << " not registered ("
+                     << (registered.ok() ? "implausible result" : registered.message())
+                     << "): previous velocity kept";
+      }
+      T_world = T_world * T_previous_current;
+      T_previous_current_guess = T_previous_current;
+      last_dt = dt;
+    }
+    m.scan_times_s_.push_back(t);
+    m.scan_poses_.push_back(T_world);
+    previous.swap(current);
+    have_previous = true;
+  }
+  if (m.scan_times_s_.size() < 2) {
+    return Status::Error(drive.drive_dir + ": fewer than two readable sweeps for the motion");
+  }
   *motion = std::move(m);
   return Status::Ok();
 }
 
 Rigid3d DriveMotion::T_world_lidar(double t_s) const {
-  return trajectory_.T_world_imu_s(t_s) * T_imu_lidar_;
+  if (source_ == Source::kOxts) return trajectory_.T_world_imu_s(t_s) * T_imu_lidar_;
+  // Constant velocity on the segment around t (the first or last one outside the sweeps).
+  const std::vector<double>& times = scan_times_s_;
+  size_t i = std::upper_bound(times.begin(), times.end(), t_s) - times.begin();
+  i = std::min(std::max<size_t>(i, 1), times.size() - 1) - 1;
+  const double dt = times[i + 1] - times[i];
+  const LidarTwist twist = ConstantVelocityTwist(scan_poses_[i].inverse() * scan_poses_[i + 1], dt);
+  return scan_poses_[i] * LidarMotion(twist, t_s - times[i]);
+}
+
+double DriveMotion::GapAround(double t_s) const {
+  if (source_ == Source::kOxts) return trajectory_.GapAround(t_s);
+  if (t_s < scan_times_s_.front()) return scan_times_s_.front() - t_s;
+  if (t_s > scan_times_s_.back()) return t_s - scan_times_s_.back();
+  return 0.0;
 }
 
 LidarPoseFunction DriveMotion::PoseFunction() const {

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <vector>
+
 #include "core/io/drive.h"
 #include "core/motion/deskew.h"
 #include "core/motion/oxts_trajectory.h"
@@ -7,23 +9,39 @@
 
 namespace stcalib {
 
-// The LiDAR's motion over a drive, from its oxts packets and calib_imu_to_velo.txt. Times are
-// seconds relative to the first oxts stamp, on the stamps' own clocks.
+// The LiDAR's motion over a drive. Two sources:
+// - oxts (Create): the oxts packets and calib_imu_to_velo.txt, interpolated between packets;
+// - scan registration (CreateFromScans, for drives without oxts): each sweep registered to the
+//   previous one with NDT, and a constant velocity between consecutive sweep stamps (method.md
+//   §3's constant-velocity model), extrapolated with the nearest segment's velocity.
+// Times are seconds relative to a reference stamp (the first oxts or LiDAR stamp).
 class DriveMotion {
  public:
+  enum class Source { kOxts, kScanRegistration };
+
   // Fails with the reason when the drive has no usable oxts (no folder, bad stamps).
   static Status Create(const Drive& drive, DriveMotion* motion);
+  // Fails when fewer than two sweeps can be read and registered.
+  static Status CreateFromScans(const Drive& drive, DriveMotion* motion);
 
+  Source source() const { return source_; }
   Rigid3d T_world_lidar(double t_s) const;
   LidarPoseFunction PoseFunction() const;
-  double Seconds(StampNs stamp_ns) const {
-    return NsToSeconds(stamp_ns - trajectory_.reference_ns());
-  }
-  const OxtsTrajectory& trajectory() const { return trajectory_; }
+  double Seconds(StampNs stamp_ns) const { return NsToSeconds(stamp_ns - reference_ns_); }
+  // How far the pose at t is interpolated or extrapolated from measurements [s]: the span of
+  // the oxts packets around t; for scan registration the distance outside the sweeps' stamps.
+  double GapAround(double t_s) const;
+  // Sweeps whose registration failed (their motion is the previous segment's velocity).
+  int failed_registrations() const { return failed_registrations_; }
 
  private:
+  Source source_ = Source::kOxts;
+  StampNs reference_ns_ = 0;
   OxtsTrajectory trajectory_;
   Rigid3d T_imu_lidar_ = Rigid3d::Identity();
+  std::vector<double> scan_times_s_;  // sweep stamps (scan registration)
+  std::vector<Rigid3d> scan_poses_;   // T_world_lidar at those stamps
+  int failed_registrations_ = 0;
 };
 
 // Sweep duration of a drive: mean of timestamps_end − timestamps_start, else the mean LiDAR

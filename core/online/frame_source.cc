@@ -15,7 +15,14 @@ Status DriveFrameSource::Create(const Drive* drive, const FrameSourceOptions& op
                                 std::unique_ptr<DriveFrameSource>* source) {
   STCALIB_RETURN_IF_ERROR(options.Validate());
   std::unique_ptr<DriveFrameSource> s(new DriveFrameSource(drive, options));
-  STCALIB_RETURN_IF_ERROR(DriveMotion::Create(*drive, &s->motion_));
+  if (drive->has_oxts) {
+    STCALIB_RETURN_IF_ERROR(DriveMotion::Create(*drive, &s->motion_));
+  } else {
+    LOG(WARNING) << drive->drive_dir
+                 << ": no oxts; the motion comes from registering consecutive sweeps (NDT) "
+                    "with a constant velocity between them";
+    STCALIB_RETURN_IF_ERROR(DriveMotion::CreateFromScans(*drive, &s->motion_));
+  }
   s->cache_ = std::make_unique<SweepCache>(*drive, s->motion_, s->options_.lidar);
   *source = std::move(s);
   return Status::Ok();
@@ -25,11 +32,11 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   STCALIB_RETURN_IF_ERROR(drive_->CheckFrame(frame));
   *out = CalibrationFrame();
   const double camera_s = motion_.Seconds(drive_->camera_stamps_ns[frame]);
-  const double oxts_gap_s = motion_.trajectory().GapAround(camera_s);
+  const double oxts_gap_s = motion_.GapAround(camera_s);
   if (oxts_gap_s > options_.max_oxts_gap_s) {
-    return Status::Error(drive_->drive_dir + "/oxts: frame " + std::to_string(frame) +
-                         " falls in a gap of " + std::to_string(oxts_gap_s) +
-                         " s between oxts packets (more than " +
+    return Status::Error(drive_->drive_dir + (drive_->has_oxts ? "/oxts" : "/velodyne_points") +
+                         ": frame " + std::to_string(frame) + " falls in a gap of " +
+                         std::to_string(oxts_gap_s) + " s between motion measurements (more than " +
                          std::to_string(options_.max_oxts_gap_s) + " s): no motion model");
   }
   out->index = static_cast<int>(frame);

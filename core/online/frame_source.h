@@ -36,7 +36,8 @@ struct FrameSourceOptions {
 // the stamp gap. Sweeps are cached, so a sequential pass computes each one once.
 class DriveFrameSource {
  public:
-  // Needs the drive's oxts (motion model); errors say why not.
+  // The motion model comes from the drive's oxts, or, without oxts/, from registering
+  // consecutive sweeps (constant velocity); errors say why neither works.
   static Status Create(const Drive* drive, const FrameSourceOptions& options,
                        std::unique_ptr<DriveFrameSource>* source);
   Status Load(size_t frame, CalibrationFrame* out);
