@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <limits>
 #include <memory>
 
 #include "core/online/frame_source.h"
@@ -15,6 +16,55 @@
 
 namespace stcalib {
 namespace {
+
+// A frame with image edges and maps but (here) no LiDAR points, stamped at `time_s`.
+std::shared_ptr<CalibrationFrame> BareFrame(int index, double time_s) {
+  auto frame = std::make_shared<CalibrationFrame>();
+  frame->index = index;
+  frame->camera_time_s = time_s;
+  frame->camera.width = 64;
+  frame->camera.height = 32;
+  frame->image.edge_pixels = 100;
+  for (int kind = 0; kind < 2; ++kind) {
+    frame->distance_px[kind] = cv::Mat::zeros(32, 64, CV_32F);
+    frame->gray_map[kind] = cv::Mat::zeros(32, 64, CV_32F);
+    frame->score_maps[kind].push_back(frame->gray_map[kind]);
+  }
+  return frame;
+}
+
+// Fault injection at the calibrator itself: frames that go back in time, repeat a stamp, carry
+// NaN motion or have no image edges are refused with the reason, and the estimate stays.
+TEST(OnlineCalibrator, RefusesBadFramesAndKeepsTheEstimate) {
+  CalibrationState start;
+  start.T_camera_lidar =
+      MakeRigid(ExpSO3(Eigen::Vector3d(0.1, -0.2, 0.3)), Eigen::Vector3d(0.1, 0.2, -0.3));
+  start.time_offset_s = 0.01;
+  OnlineCalibrator calibrator(OnlineCalibratorOptions(), start);
+  FrameReport r = calibrator.AddFrame(BareFrame(0, 1.0));
+  EXPECT_FALSE(r.skipped);
+  EXPECT_NE(r.reason.find("too few LiDAR edge points"), std::string::npos) << r.reason;
+  r = calibrator.AddFrame(BareFrame(1, 1.0));  // duplicated stamp
+  EXPECT_TRUE(r.skipped);
+  EXPECT_NE(r.reason.find("duplicated or out of order"), std::string::npos) << r.reason;
+  r = calibrator.AddFrame(BareFrame(2, 0.9));  // out of order
+  EXPECT_TRUE(r.skipped);
+  auto nan_motion = BareFrame(3, 1.1);
+  nan_motion->twist.linear_m_s.x() = std::numeric_limits<double>::quiet_NaN();
+  r = calibrator.AddFrame(nan_motion);
+  EXPECT_TRUE(r.skipped);
+  EXPECT_NE(r.reason.find("non-finite"), std::string::npos) << r.reason;
+  auto black = BareFrame(4, 1.2);
+  black->image.edge_pixels = 0;
+  r = calibrator.AddFrame(black);
+  EXPECT_TRUE(r.skipped);
+  EXPECT_NE(r.reason.find("no image edges"), std::string::npos) << r.reason;
+  // Good data again: taken (in time order after the last good frame).
+  r = calibrator.AddFrame(BareFrame(5, 1.3));
+  EXPECT_FALSE(r.skipped) << r.reason;
+  EXPECT_TRUE(calibrator.state().T_camera_lidar.isApprox(start.T_camera_lidar));
+  EXPECT_EQ(calibrator.state().time_offset_s, start.time_offset_s);
+}
 
 TEST(Calibration, StagesAgainstSimulatedTruth) {
   testing::ScopedTempDir tmp;
