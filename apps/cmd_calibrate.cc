@@ -53,13 +53,9 @@ cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
                         const CalibrationState& state, const std::string& title) {
   cv::Mat canvas;
   image.convertTo(canvas, CV_8UC3, 0.55);
-  const double e = frame.e0_s + state.time_offset_s;
   for (size_t i = 0; i < frame.size(); ++i) {
-    const Eigen::Vector3d p =
-        state.T_camera_lidar * ApplyLidarMotion<double>(frame.twist, e, frame.points_lidar[i]);
     Eigen::Vector2d pixel;
-    double depth;
-    if (!frame.camera.Project<double>(p, &pixel, &depth) || !frame.camera.InImage(pixel)) continue;
+    if (!ProjectFramePoint(frame, state, i, &pixel) || !frame.camera.InImage(pixel)) continue;
     const int u = static_cast<int>(std::lround(pixel.x())),
               v = static_cast<int>(std::lround(pixel.y()));
     const bool near = frame.image.distance_raw_px.at<float>(v, u) <= 2.0f;

@@ -204,6 +204,20 @@ std::string SimulatedDrive(const std::string& out) {
   return "";
 }
 
+// Simulates a drive with `args` into `out` and returns its drive folder ("" on failure).
+std::string SimulateDrive(const std::string& out, const std::string& args) {
+  if (RunStcalib("simulate --out=" + out + " " + args).exit_code != 0) return "";
+  return SimulatedDrive(out);
+}
+
+// `calibrate` with configs/sim.flags from ±2° on each axis and ±5 cm (signs from `seed`).
+RunResult CalibrateFromTwoDegrees(const std::string& drive, const std::string& out, int seed) {
+  return RunStcalib(
+      "calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" + drive +
+      " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=" + std::to_string(seed) +
+      " --out=" + out);
+}
+
 // Replaces line `index` (0-based) of a text file; `text` empty removes it.
 void EditLine(const std::string& path, size_t index, const std::string* text) {
   std::istringstream in(testing::ReadFile(path));
@@ -222,11 +236,7 @@ void EditLine(const std::string& path, size_t index, const std::string* text) {
 
 TEST(Cli, CalibrateSkipsFaultyFramesKeepsTheEstimateAndRecovers) {
   testing::ScopedTempDir tmp;
-  ASSERT_EQ(
-      RunStcalib("simulate --out=" + tmp.path() + " --frames=16 --seed=2 --time_offset_s=0.02")
-          .exit_code,
-      0);
-  const std::string drive = SimulatedDrive(tmp.path());
+  const std::string drive = SimulateDrive(tmp.path(), "--frames=16 --seed=2 --time_offset_s=0.02");
   ASSERT_FALSE(drive.empty());
   // Frame 4: a burst of NaN points.
   {
@@ -275,9 +285,7 @@ TEST(Cli, CalibrateSkipsFaultyFramesKeepsTheEstimateAndRecovers) {
   std::filesystem::remove(drive + "/velodyne_points/labels/0000000014.bin");
 
   const std::string out = tmp.path() + "/out";
-  const RunResult r =
-      RunStcalib("calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" + drive +
-                 " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=2 --out=" + out);
+  const RunResult r = CalibrateFromTwoDegrees(drive, out, 2);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   const std::string csv = testing::ReadFile(out + "/per_frame.csv");
   EXPECT_THAT(csv, HasSubstr("4,0,"));
@@ -299,16 +307,11 @@ TEST(Cli, CalibrateSkipsFaultyFramesKeepsTheEstimateAndRecovers) {
 // constant velocity between them (method.md §3's fallback), and the calibration still works.
 TEST(Cli, CalibratesADriveWithoutOxtsFromScanRegistration) {
   testing::ScopedTempDir tmp;
-  ASSERT_EQ(
-      RunStcalib("simulate --out=" + tmp.path() + " --frames=12 --seed=3 --time_offset_s=0.03")
-          .exit_code,
-      0);
-  const std::string drive = SimulatedDrive(tmp.path());
+  const std::string drive = SimulateDrive(tmp.path(), "--frames=12 --seed=3 --time_offset_s=0.03");
+  ASSERT_FALSE(drive.empty());
   std::filesystem::remove_all(drive + "/oxts");
   const std::string out = tmp.path() + "/out";
-  const RunResult r =
-      RunStcalib("calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" + drive +
-                 " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=3 --out=" + out);
+  const RunResult r = CalibrateFromTwoDegrees(drive, out, 3);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("no oxts; the motion comes from registering consecutive sweeps"));
   const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
@@ -323,15 +326,11 @@ TEST(Cli, DegenerateScenesAreReportedNeverAWrongSuccess) {
   for (const std::string scene : {"open", "poles"}) {
     SCOPED_TRACE(scene);
     testing::ScopedTempDir tmp;
-    ASSERT_EQ(RunStcalib("simulate --out=" + tmp.path() + " --frames=12 --seed=4 --scene=" + scene +
-                         " --time_offset_s=0.02")
-                  .exit_code,
-              0);
+    const std::string drive = SimulateDrive(
+        tmp.path(), "--frames=12 --seed=4 --scene=" + scene + " --time_offset_s=0.02");
+    ASSERT_FALSE(drive.empty());
     const std::string out = tmp.path() + "/out";
-    const RunResult r =
-        RunStcalib("calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" +
-                   SimulatedDrive(tmp.path()) +
-                   " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=1 --out=" + out);
+    const RunResult r = CalibrateFromTwoDegrees(drive, out, 1);
     const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
     const bool converged = result["converged"].get<bool>();
     EXPECT_EQ(r.exit_code, converged ? 0 : 1) << r.output;

@@ -8,6 +8,7 @@
 #include "core/features/image_features.h"
 #include "core/features/lidar_edges.h"
 #include "core/motion/motion_model.h"
+#include "core/types/calibration.h"
 #include "core/types/camera_model.h"
 
 namespace stcalib {
@@ -35,5 +36,16 @@ struct CalibrationFrame {
 
   size_t size() const { return points_lidar.size(); }
 };
+
+// Pixel of edge point i of `frame` at `state` (carried by the motion model over e0 + δ, then
+// through T_camera_lidar and the camera); false when it falls behind the camera.
+inline bool ProjectFramePoint(const CalibrationFrame& frame, const CalibrationState& state,
+                              size_t i, Eigen::Vector2d* pixel) {
+  const Eigen::Vector3d p =
+      state.T_camera_lidar * ApplyLidarMotion<double>(frame.twist, frame.e0_s + state.time_offset_s,
+                                                      frame.points_lidar[i]);
+  double depth;
+  return frame.camera.Project<double>(p, pixel, &depth);
+}
 
 }  // namespace stcalib

@@ -133,13 +133,9 @@ std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& fra
   pruned->kinds.clear();
   const double mu = margin * frame.camera.width;
   const double mv = margin * frame.camera.height;
-  const double e = frame.e0_s + state.time_offset_s;
   for (size_t i = 0; i < frame.size(); ++i) {
-    const Eigen::Vector3d p =
-        state.T_camera_lidar * ApplyLidarMotion<double>(frame.twist, e, frame.points_lidar[i]);
     Eigen::Vector2d pixel;
-    double depth;
-    if (!frame.camera.Project<double>(p, &pixel, &depth)) continue;
+    if (!ProjectFramePoint(frame, state, i, &pixel)) continue;
     if (pixel.x() < mu || pixel.y() < mv || pixel.x() > frame.camera.width - mu ||
         pixel.y() > frame.camera.height - mv) {
       continue;
