@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "core/online/convergence.h"
 #include "core/online/frame_source.h"
 #include "core/online/online_calibrator.h"
 #include "core/types/calibration.h"
@@ -19,6 +20,7 @@ struct CalibrateJob {
   double disturb_rot_deg = 2.0;
   OnlineCalibratorOptions online;
   FrameSourceOptions source;
+  ConvergenceOptions convergence;
   bool progress = true;
 };
 

@@ -16,6 +16,7 @@
 #include "apps/plot.h"
 #include "core/io/image.h"
 #include "core/io/text.h"
+#include "core/online/convergence.h"
 #include "core/search/adaptive_grid_search.h"
 
 namespace stcalib::cli {
@@ -117,6 +118,8 @@ CalibrateJob CalibrateJobFromFlags() {
   job.source.lidar.remove_dynamic = FLAGS_remove_dynamic;
   job.source.suppress_texture = FLAGS_suppress_texture;
   job.source.oriented_maps = FLAGS_oriented_maps;
+  job.convergence.check_suppressed_health = FLAGS_check_suppressed_health;
+  job.convergence.health_check.min_health = FLAGS_min_health;
   return job;
 }
 
@@ -225,109 +228,39 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   outcome->estimate = calibrator.state();
   outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
 
-  // Aliasing guard over δ on the final window.
-  WindowScorer scorer(calibrator.SearchWindow(), job.online.score);
-  const TimeOffsetProfile profile =
-      ProfileTimeOffset(&scorer, outcome->estimate, job.online.time_offset_bound_s, 0.0025);
-  outcome->alias_suspect = profile.alias_suspect;
-  std::array<RotationAxisProfile, 3> axis_profiles;
-  for (int axis = 0; axis < 3; ++axis) {
-    axis_profiles[axis] = ProfileRotationAxis(&scorer, outcome->estimate, axis);
-    VLOG(1) << kAxisNames[axis] << " profile: best " << axis_profiles[axis].best_deg << " second "
-            << axis_profiles[axis].second_peak_deg << " ratio "
-            << axis_profiles[axis].second_peak_ratio;
-  }
-
-  // Convergence: the last used frame's health is high and the estimate has settled over the
-  // last three used frames (skipped frames say nothing).
-  std::vector<const FrameReport*> used;
-  for (const FrameReport& r : outcome->reports) {
-    if (!r.skipped) used.push_back(&r);
-  }
-  const FrameReport empty_report;
-  const FrameReport& final_report = used.empty() ? empty_report : *used.back();
-  double settle_deg = 0;
-  for (size_t k = used.size() >= 3 ? used.size() - 3 : 0; k < used.size(); ++k) {
-    settle_deg = std::max(settle_deg, RotationErrorDeg(used[k]->after.T_camera_lidar.linear(),
-                                                       outcome->estimate.T_camera_lidar.linear()));
-  }
-  const int skipped = static_cast<int>(outcome->reports.size() - used.size());
-  const int points = final_report.points;
-  // Axes the last refinement could not pin down (std above the thresholds): they were held, so
-  // their values say nothing about the data.
-  std::vector<std::string> unobservable;
-  for (int k = 0; k < kNumAxes; ++k) {
-    if (k == 6 && !job.online.refine.estimate_time_offset) continue;
-    if (!final_report.refine.observable[k]) unobservable.push_back(kAxisNames[k]);
-  }
-  std::string unobservable_text;
-  for (const std::string& axis : unobservable) {
-    unobservable_text += (unobservable_text.empty() ? "" : ", ") + axis;
-  }
-  const double moved_deg =
-      RotationErrorDeg(outcome->estimate.T_camera_lidar.linear(), initial.T_camera_lidar.linear());
-  const bool at_time_bound =
-      std::abs(outcome->estimate.time_offset_s) >= job.online.time_offset_bound_s - 0.0025;
-  const bool at_rotation_bound = moved_deg >= job.online.search.max_rotation_offset_deg - 0.5;
-  if (!used.empty() && !unobservable.empty()) {
-    // Values the data cannot pin down carry no information from this drive: they go back to the
-    // start (earlier frames may have moved them before their ambiguity showed).
-    outcome->estimate =
-        KeepObservableAxes(initial, outcome->estimate, final_report.refine.observable);
-    outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
-  }
-  // Along each rotation axis the score of the last frames must peak at the estimate, and only
-  // there: a peak elsewhere means the windows disagree, a second peak that the axis is ambiguous.
-  std::string profile_problem;
+  // The verdict (core/online/convergence.h): the app only formats it.
+  const ConvergenceVerdict verdict =
+      JudgeConvergence(calibrator, outcome->reports, initial, job.online, job.convergence);
+  outcome->estimate = verdict.estimate;
+  outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
+  outcome->converged = verdict.converged;
+  outcome->reason = verdict.reason;
+  outcome->alias_suspect = verdict.time_offset_profile.alias_suspect;
+  const TimeOffsetProfile& profile = verdict.time_offset_profile;
   nlohmann::json profiles_json;
   for (int axis = 0; axis < 3; ++axis) {
-    const RotationAxisProfile& p = axis_profiles[axis];
+    const RotationAxisProfile& p = verdict.rotation_profiles[axis];
     profiles_json[kAxisNames[axis]] = {{"best_offset_deg", p.best_deg},
                                        {"second_peak_offset_deg", p.second_peak_deg},
                                        {"second_peak_ratio", p.second_peak_ratio}};
-    char text[160] = "";
-    if (std::abs(p.best_deg) > 0.5) {
-      std::snprintf(text, sizeof(text), "the last frames' score peaks %+.2f deg away on %s",
-                    p.best_deg, kAxisNames[axis]);
-    } else if (p.ambiguous) {
-      std::snprintf(text, sizeof(text),
-                    "%s is ambiguous: a second score peak %+.2f deg away reaches %.0f%% of the "
-                    "best",
-                    kAxisNames[axis], p.second_peak_deg, 100 * p.second_peak_ratio);
-    }
-    if (text[0] != '\0' && profile_problem.empty()) profile_problem = text;
   }
-  if (used.empty()) {
-    outcome->reason = "not converged: all " + std::to_string(skipped) +
-                      " frames were skipped (first reason: " + outcome->reports.front().reason +
-                      ")";
-  } else if (points < 30) {
-    outcome->reason = "not converged: no usable features (" + std::to_string(points) +
-                      " LiDAR edge points in the image)";
-  } else if (static_cast<int>(used.size()) < 3) {
-    outcome->reason = "not converged: " + std::to_string(used.size()) +
-                      " usable frame(s) cannot show that the estimate has settled (3 needed)";
-  } else if (at_time_bound || at_rotation_bound) {
-    outcome->reason =
-        std::string("not converged: the estimate ran to the bound of its ") +
-        (at_time_bound ? "time offset (|δ| = bound)"
-                       : "rotation search (moved " + std::to_string(moved_deg) + " deg)") +
-        ": the score has no trustworthy optimum inside the bounds";
-  } else if (!unobservable.empty()) {
-    outcome->reason = "not converged: not observable in this drive: " + unobservable_text +
-                      " (held at their start values; the scene does not constrain them)";
-  } else if (!profile_problem.empty()) {
-    outcome->reason = "not converged: " + profile_problem;
-  } else if (final_report.health < 0.8) {
-    outcome->reason = "not converged: health " + std::to_string(final_report.health) +
-                      " < 0.8 (the estimate is not a clear optimum of the score)";
-  } else if (settle_deg > 0.3) {
-    outcome->reason = "not converged: still moving (" + std::to_string(settle_deg) +
-                      " deg over the last 3 frames)";
-  } else {
-    outcome->converged = true;
-    outcome->reason = "converged";
+  nlohmann::json health_check_json = nullptr;
+  if (verdict.health_checked) {
+    const HealthCheckResult& h = verdict.health_check;
+    health_check_json = {{"decided", h.decided},
+                         {"holds", h.holds},
+                         {"mean_health", h.mean_health},
+                         {"mean_neighbour_gain", h.mean_neighbour_gain},
+                         {"reason", h.reason}};
   }
+  const FrameReport empty_report;
+  const FrameReport* final_report_ptr = &empty_report;
+  for (const FrameReport& r : outcome->reports) {
+    if (!r.skipped) final_report_ptr = &r;
+  }
+  const FrameReport& final_report = *final_report_ptr;
+  const int skipped = verdict.skipped_frames;
+  const std::vector<std::string>& unobservable = verdict.unobservable_axes;
   const RefineResult& refine = final_report.refine;
 
   // Outputs.
@@ -365,6 +298,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"observable", observable_json},
       {"unobservable_axes", unobservable},
       {"rotation_profiles", profiles_json},
+      {"suppressed_health_check", health_check_json},
       {"converged", outcome->converged},
       {"reason", outcome->reason},
       {"alias_suspect", outcome->alias_suspect},

@@ -50,7 +50,11 @@ DEFINE_double(observable_rotation_deg, 0.15,
 DEFINE_double(observable_translation_m, 0.04,
               "refine: a translation axis is observable below this std [m]");
 DEFINE_double(observable_time_s, 0.006, "refine: δ is observable below this std [s]");
-DEFINE_double(min_health, 0.85, "check: the calibration holds when the mean health reaches this");
+DEFINE_double(min_health, 0.85,
+              "check, calibrate: the calibration holds when the mean health reaches this");
+DEFINE_bool(check_suppressed_health, true,
+            "calibrate: converged also needs the health check on texture-suppressed maps of the "
+            "last 9 frames to hold");
 DEFINE_int32(local_map_sweeps, 3, "calibrate: sweeps merged into the local map");
 DEFINE_bool(remove_dynamic, true, "calibrate: remove LiDAR points of moving objects");
 DEFINE_bool(use_ndt, false, "calibrate: refine the local map's poses with PCL NDT");

@@ -46,6 +46,7 @@ DECLARE_double(observable_rotation_deg);
 DECLARE_double(observable_translation_m);
 DECLARE_double(observable_time_s);
 DECLARE_double(min_health);
+DECLARE_bool(check_suppressed_health);
 DECLARE_int32(local_map_sweeps);
 DECLARE_bool(remove_dynamic);
 DECLARE_bool(use_ndt);

@@ -76,6 +76,10 @@ class OnlineCalibrator {
   void SetState(const CalibrationState& state) { state_ = state; }
   // The frames the last search used (the latest window_frames).
   std::vector<const CalibrationFrame*> SearchWindow() const;
+  // The frames the last refinement used (the latest refine_frames), oldest first.
+  std::vector<std::shared_ptr<const CalibrationFrame>> RecentFrames() const {
+    return {window_.begin(), window_.end()};
+  }
 
  private:
   OnlineCalibratorOptions options_;

@@ -1,0 +1,148 @@
+#include "core/online/convergence.h"
+
+#include <glog/logging.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace stcalib {
+
+std::shared_ptr<const CalibrationFrame> WithSuppressedScoreMaps(const CalibrationFrame& frame) {
+  auto view = std::make_shared<CalibrationFrame>(frame);
+  for (int kind = 0; kind < 2; ++kind) {
+    const cv::Mat& oriented = frame.image.oriented[kind].idt_suppressed;
+    const cv::Mat& map = oriented.empty() ? frame.image.idt_suppressed : oriented;
+    view->score_maps[kind].clear();
+    if (!map.empty()) view->score_maps[kind].push_back(map);
+  }
+  return view;
+}
+
+ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
+                                    const std::vector<FrameReport>& reports,
+                                    const CalibrationState& initial,
+                                    const OnlineCalibratorOptions& online,
+                                    const ConvergenceOptions& options) {
+  ConvergenceVerdict verdict;
+  verdict.estimate = calibrator.state();
+
+  // Aliasing guard over δ and the rotation-axis profiles, on the last search window.
+  WindowScorer scorer(calibrator.SearchWindow(), online.score);
+  verdict.time_offset_profile =
+      ProfileTimeOffset(&scorer, verdict.estimate, online.time_offset_bound_s, 0.0025);
+  for (int axis = 0; axis < 3; ++axis) {
+    verdict.rotation_profiles[axis] = ProfileRotationAxis(&scorer, verdict.estimate, axis);
+  }
+
+  // Skipped frames say nothing.
+  std::vector<const FrameReport*> used;
+  for (const FrameReport& r : reports) {
+    if (!r.skipped) used.push_back(&r);
+  }
+  verdict.used_frames = static_cast<int>(used.size());
+  verdict.skipped_frames = static_cast<int>(reports.size() - used.size());
+  const FrameReport empty_report;
+  const FrameReport& last = used.empty() ? empty_report : *used.back();
+  double settle_deg = 0;
+  for (size_t k = used.size() >= static_cast<size_t>(options.settle_frames)
+                      ? used.size() - options.settle_frames
+                      : 0;
+       k < used.size(); ++k) {
+    settle_deg = std::max(settle_deg, RotationErrorDeg(used[k]->after.T_camera_lidar.linear(),
+                                                       verdict.estimate.T_camera_lidar.linear()));
+  }
+
+  // Axes the last refinement could not pin down were held: they go back to the start (earlier
+  // frames may have moved them before their ambiguity showed).
+  std::string unobservable_text;
+  for (int k = 0; k < kNumAxes; ++k) {
+    if (k == 6 && !online.refine.estimate_time_offset) continue;
+    if (last.refine.observable[k]) continue;
+    verdict.unobservable_axes.push_back(kAxisNames[k]);
+    unobservable_text += (unobservable_text.empty() ? "" : ", ") + std::string(kAxisNames[k]);
+  }
+  const double moved_deg =
+      RotationErrorDeg(verdict.estimate.T_camera_lidar.linear(), initial.T_camera_lidar.linear());
+  const bool at_time_bound = std::abs(verdict.estimate.time_offset_s) >=
+                             online.time_offset_bound_s - options.time_bound_margin_s;
+  const bool at_rotation_bound =
+      moved_deg >= online.search.max_rotation_offset_deg - options.rotation_bound_margin_deg;
+  if (!used.empty() && !verdict.unobservable_axes.empty()) {
+    verdict.estimate = KeepObservableAxes(initial, verdict.estimate, last.refine.observable);
+  }
+
+  std::string profile_problem;
+  for (int axis = 0; axis < 3 && profile_problem.empty(); ++axis) {
+    const RotationAxisProfile& p = verdict.rotation_profiles[axis];
+    char text[160] = "";
+    if (std::abs(p.best_deg) > options.max_profile_offset_deg) {
+      std::snprintf(text, sizeof(text), "the last frames' score peaks %+.2f deg away on %s",
+                    p.best_deg, kAxisNames[axis]);
+    } else if (p.ambiguous) {
+      std::snprintf(text, sizeof(text),
+                    "%s is ambiguous: a second score peak %+.2f deg away reaches %.0f%% of the "
+                    "best",
+                    kAxisNames[axis], p.second_peak_deg, 100 * p.second_peak_ratio);
+    }
+    profile_problem = text;
+  }
+
+  char text[256];
+  if (used.empty()) {
+    verdict.reason = "not converged: all " + std::to_string(verdict.skipped_frames) +
+                     " frames were skipped" +
+                     (reports.empty() ? "" : " (first reason: " + reports.front().reason + ")");
+  } else if (last.points < options.min_points) {
+    verdict.reason = "not converged: no usable features (" + std::to_string(last.points) +
+                     " LiDAR edge points in the image)";
+  } else if (verdict.used_frames < options.min_frames) {
+    verdict.reason = "not converged: " + std::to_string(verdict.used_frames) +
+                     " usable frame(s) cannot show that the estimate has settled (" +
+                     std::to_string(options.min_frames) + " needed)";
+  } else if (at_time_bound || at_rotation_bound) {
+    std::snprintf(text, sizeof(text),
+                  "not converged: the estimate ran to the bound of its %s: the score has no "
+                  "trustworthy optimum inside the bounds",
+                  at_time_bound ? "time offset (|δ| = bound)" : "rotation search");
+    verdict.reason = text;
+    if (!at_time_bound) verdict.reason += " (moved " + std::to_string(moved_deg) + " deg)";
+  } else if (!verdict.unobservable_axes.empty()) {
+    verdict.reason = "not converged: not observable in this drive: " + unobservable_text +
+                     " (held at their start values; the scene does not constrain them)";
+  } else if (!profile_problem.empty()) {
+    verdict.reason = "not converged: " + profile_problem;
+  } else if (last.health < options.min_final_health) {
+    std::snprintf(text, sizeof(text),
+                  "not converged: health %.3f < %.2f (the estimate is not a clear optimum of the "
+                  "score)",
+                  last.health, options.min_final_health);
+    verdict.reason = text;
+  } else if (settle_deg > options.max_settle_deg) {
+    std::snprintf(text, sizeof(text),
+                  "not converged: still moving (%.3f deg over the last %d frames)", settle_deg,
+                  options.settle_frames);
+    verdict.reason = text;
+  } else {
+    verdict.converged = true;
+    verdict.reason = "converged";
+  }
+  if (!verdict.converged || !options.check_suppressed_health) return verdict;
+
+  // The independent check on the texture-suppressed maps of the last frames.
+  std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
+  const size_t keep = std::min<size_t>(recent.size(), options.check_frames);
+  std::vector<std::shared_ptr<const CalibrationFrame>> frames;
+  for (size_t k = recent.size() - keep; k < recent.size(); ++k) {
+    frames.push_back(WithSuppressedScoreMaps(*recent[k]));
+  }
+  verdict.health_check = CheckCalibrationHealth(frames, verdict.estimate, options.health_check);
+  verdict.health_checked = true;
+  if (!verdict.health_check.decided || !verdict.health_check.holds) {
+    verdict.converged = false;
+    verdict.reason = "not converged: the check on texture-suppressed maps of the last " +
+                     std::to_string(keep) + " frames says " + verdict.health_check.reason;
+  }
+  return verdict;
+}
+
+}  // namespace stcalib
