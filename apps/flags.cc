@@ -29,7 +29,7 @@ DEFINE_int32(window_frames, 3, "calibrate: sliding window of frames searched and
 DEFINE_double(time_offset_bound_s, 0.15, "calibrate: |δ| bound [s]");
 DEFINE_bool(estimate_time_offset, true, "calibrate: estimate δ (false: keep δ0)");
 DEFINE_string(loss, "cauchy", "calibrate: robust loss, cauchy | huber");
-DEFINE_double(loss_scale_px, 3.0, "calibrate: robust-loss scale [px]");
+DEFINE_double(loss_scale_px, 1.0, "calibrate: robust-loss scale [px]");
 DEFINE_double(horizontal_weight, 0.5, "calibrate: weight w of horizontal edges (vertical: 1 - w)");
 DEFINE_double(alpha1_rotation_deg, 1.0, "search: large rotation step [deg]");
 DEFINE_double(alpha2_translation_m, 0.04, "search: large translation step [m]");
@@ -72,3 +72,5 @@ DEFINE_double(lidar_delay_s, 0.1, "eval-temporal: the kept sweeps arrive this la
 DEFINE_double(eval_max_range_m, 120.0, "eval-temporal: points beyond this range are left out [m]");
 DEFINE_bool(coarse_until_window_full, true,
             "calibrate: coarse-to-fine search on every frame until the search window is full");
+DEFINE_bool(wait_for_full_window, true,
+            "calibrate: no update before the search window holds --window_frames frames");

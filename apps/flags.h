@@ -58,3 +58,4 @@ DECLARE_int32(lidar_decimation);
 DECLARE_double(lidar_delay_s);
 DECLARE_double(eval_max_range_m);
 DECLARE_bool(coarse_until_window_full);
+DECLARE_bool(wait_for_full_window);

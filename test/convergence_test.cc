@@ -16,7 +16,8 @@ TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
   ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
-  // Plain score maps, as configs/kitti.flags calibrates on.
+  // Plain score maps (what configs/kitti.flags calibrated on until it switched to suppressed
+  // ones; any drive may still be calibrated on them).
   FrameSourceOptions options;
   options.suppress_texture = false;
   std::unique_ptr<DriveFrameSource> source;
@@ -32,9 +33,9 @@ TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
   }
   CalibrationState kitti;
   kitti.T_camera_lidar = drive.T_camera_lidar;
-  // Where `stcalib calibrate --flagfile=configs/kitti.flags --perturb_rot_deg=2
-  // --perturb_trans_m=0.05 --seed=4` ended before this check existed, and claimed convergence:
-  // 3.0° from KITTI's calibration.
+  // Where `stcalib calibrate --flagfile=configs/kitti.flags --suppress_texture=false
+  // --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=4` ended before this check existed, and
+  // claimed convergence: 3.0° from KITTI's calibration.
   const CalibrationState wrong = Step(kitti, Eigen::Vector3d(-2.40, -1.76, -0.30) * M_PI / 180.0,
                                       Eigen::Vector3d(0.05, -0.10, 0.10), 0.0);
   const HealthCheckOptions check;

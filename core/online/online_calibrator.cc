@@ -103,6 +103,15 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   }
   WindowScorer scorer(frames, options_.score);
   report.score_before = scorer.Evaluate(state_, -1);
+  if (options_.wait_for_full_window && static_cast<int>(frames.size()) < options_.window_frames) {
+    report.reason = "window filling (" + std::to_string(frames.size()) + " of " +
+                    std::to_string(options_.window_frames) + " frames): estimate kept";
+    report.after = state_;
+    report.score_after = report.score_before;
+    report.gray_rate_before = report.gray_rate_after = scorer.GrayRate(state_);
+    report.health_before = report.health = HealthScore(&scorer, state_);
+    return report;
+  }
 
   // Search: coarse-to-fine when lost, the finest map alone when tracking.
   auto start = std::chrono::steady_clock::now();

@@ -26,6 +26,9 @@ struct OnlineCalibratorOptions {
   // on the finest one only.
   double lost_health = 0.9;
   bool coarse_until_window_full = true;
+  // No update before the search window holds window_frames frames: one frame's score can have
+  // its best optimum degrees away (a simulated drive, frame 0 alone: 5.9° off from a 3.5° start).
+  bool wait_for_full_window = true;
   // Points are kept when they project inside the image shrunk by this share of its size on
   // each side, at the estimate when their frame arrives.
   double point_margin = 0.02;

@@ -146,7 +146,12 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(n, n);
     if (covariance.GetCovarianceMatrixInTangentSpace(blocks, C.data())) {
       const double dof = std::max(1, result.residuals - n);
-      const double sigma2 = 2.0 * summary.final_cost / dof;
+      // The residual variance from the fit, but never above the loss scale squared: far from
+      // the optimum the fit is poor, and an inflated variance would call every axis
+      // unobservable exactly when the estimate most needs to move (a scene that does not
+      // constrain an axis shows it in C, whatever the variance).
+      const double sigma2 =
+          std::min(2.0 * summary.final_cost / dof, options.loss_scale_px * options.loss_scale_px);
       // Tangent of EigenQuaternionManifold: q ⊕ δ = [cos|δ|, sin|δ|·δ/|δ|] ⊗ q, a rotation of
       // 2δ on the camera side; about the LiDAR axes that is 2·Rᵀ·δ.
       Eigen::Matrix<double, kNumAxes, kNumAxes> J =

@@ -18,7 +18,7 @@ namespace stcalib {
 struct RefineOptions {
   enum class Loss { kHuber, kCauchy };
   Loss loss = Loss::kCauchy;
-  double loss_scale_px = 3.0;      ///< robust-loss scale [px]
+  double loss_scale_px = 1.0;      ///< robust-loss scale [px]
   double horizontal_weight = 0.5;  ///< w of method.md §6
   // Weak priors: rotation towards the search result, translation and δ towards the mount (the
   // initial calibration); they hold only what the data leaves free (δ against the forward
