@@ -155,6 +155,16 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   } else {
     candidates.emplace_back(report.search.state, "search");
   }
+  if (options_.search_from_last_healthy && report.coarse_search && has_last_healthy_ &&
+      RotationErrorDeg(last_healthy_.T_camera_lidar.linear(), state_.T_camera_lidar.linear()) >
+          options_.search.alpha3_rotation_deg) {
+    const SearchResult again = AdaptiveGridSearch(&scorer, last_healthy_, anchor_, search_options);
+    report.search.evaluations += again.evaluations;
+    const bool hold = report.refine.covariance_ok && !all_observable;
+    candidates.emplace_back(
+        hold ? KeepObservableAxes(state_, again.state, report.refine.observable) : again.state,
+        "search from the last healthy estimate");
+  }
   report.after = state_;
   report.reason = "no candidate scored better: estimate kept";
   double best = before_long;
@@ -187,6 +197,11 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   report.gray_rate_after = scorer.GrayRate(state_);
   // The health of an unchanged estimate is the one measured before.
   report.health = report.accepted ? HealthScore(&scorer, state_) : report.health_before;
+  if (report.health >= options_.lost_health &&
+      static_cast<int>(frames.size()) >= options_.window_frames) {
+    has_last_healthy_ = true;
+    last_healthy_ = state_;
+  }
   return report;
 }
 

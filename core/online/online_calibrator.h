@@ -32,6 +32,8 @@ struct OnlineCalibratorOptions {
   // Points are kept when they project inside the image shrunk by this share of its size on
   // each side, at the estimate when their frame arrives.
   double point_margin = 0.02;
+  // When lost, also search from the last healthy estimate and offer the result as a candidate.
+  bool search_from_last_healthy = true;
   // While tracking (not lost), an accepted update moves this share of the way to the new
   // estimate: a first-order filter that averages the scatter of single windows.
   double tracking_gain = 1.0;
@@ -88,6 +90,10 @@ class OnlineCalibrator {
   OnlineCalibratorOptions options_;
   CalibrationState state_;
   CalibrationState anchor_;  ///< the initial calibration: the search's bounds are around it
+  // The latest estimate whose health reached lost_health after a full window: when the estimate
+  // is lost, a search from there is a candidate too (a disturbance or a wrong jump).
+  bool has_last_healthy_ = false;
+  CalibrationState last_healthy_;
   std::deque<std::shared_ptr<const CalibrationFrame>> window_;  // the last refine_frames frames
   double last_camera_time_s_ = -std::numeric_limits<double>::infinity();
 };
