@@ -92,6 +92,7 @@ CalibrateJob CalibrateJobFromFlags() {
   o.lost_health = FLAGS_lost_health;
   o.coarse_until_window_full = FLAGS_coarse_until_window_full;
   o.wait_for_full_window = FLAGS_wait_for_full_window;
+  o.search_from_last_healthy = FLAGS_search_from_last_healthy;
   o.score.horizontal_weight = FLAGS_horizontal_weight;
   o.search.alpha1_rotation_deg = FLAGS_alpha1_rotation_deg;
   o.search.alpha2_translation_m = FLAGS_alpha2_translation_m;

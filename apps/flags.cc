@@ -74,3 +74,5 @@ DEFINE_bool(coarse_until_window_full, true,
             "calibrate: coarse-to-fine search on every frame until the search window is full");
 DEFINE_bool(wait_for_full_window, true,
             "calibrate: no update before the search window holds --window_frames frames");
+DEFINE_bool(search_from_last_healthy, true,
+            "calibrate: when lost, also search from the last healthy estimate");

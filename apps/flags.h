@@ -59,3 +59,4 @@ DECLARE_double(lidar_delay_s);
 DECLARE_double(eval_max_range_m);
 DECLARE_bool(coarse_until_window_full);
 DECLARE_bool(wait_for_full_window);
+DECLARE_bool(search_from_last_healthy);
