@@ -137,33 +137,27 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   WindowScorer long_scorer(refine_frames, options_.score);
   const double before_long = long_scorer.Evaluate(state_, -1).score;
   std::vector<std::pair<CalibrationState, std::string>> candidates;
-  if (report.refine.usable) {
-    candidates.emplace_back(
-        KeepObservableAxes(state_, report.refine.state, report.refine.observable), "refined");
+  // A candidate keeps the axes the refinement found unobservable where they were: a degenerate
+  // scene (open road, poles only) must not move what it cannot see. Without a covariance the
+  // refined estimate cannot move and the search results move freely.
+  std::string held;
+  for (int k = 0; k < kNumAxes; ++k) {
+    if (!report.refine.observable[k]) held += std::string(", held ") + kAxisNames[k];
   }
-  // The search result too keeps the axes the refinement found unobservable where they were: a
-  // degenerate scene (open road, poles only) must not move what it cannot see.
-  bool all_observable = true;
-  for (int k = 0; k < kNumAxes; ++k) all_observable = all_observable && report.refine.observable[k];
-  if (report.refine.covariance_ok && !all_observable) {
-    std::string held;
-    for (int k = 0; k < kNumAxes; ++k) {
-      if (!report.refine.observable[k]) held += std::string(", held ") + kAxisNames[k];
-    }
+  auto add_candidate = [&](const CalibrationState& candidate, const std::string& name, bool hold) {
     candidates.emplace_back(
-        KeepObservableAxes(state_, report.search.state, report.refine.observable), "search" + held);
-  } else {
-    candidates.emplace_back(report.search.state, "search");
-  }
+        hold ? KeepObservableAxes(state_, candidate, report.refine.observable) : candidate,
+        hold ? name + held : name);
+  };
+  const bool hold_search = report.refine.covariance_ok && !held.empty();
+  if (report.refine.usable) add_candidate(report.refine.state, "refined", true);
+  add_candidate(report.search.state, "search", hold_search);
   if (options_.search_from_last_healthy && report.coarse_search && has_last_healthy_ &&
       RotationErrorDeg(last_healthy_.T_camera_lidar.linear(), state_.T_camera_lidar.linear()) >
           options_.search.alpha3_rotation_deg) {
     const SearchResult again = AdaptiveGridSearch(&scorer, last_healthy_, anchor_, search_options);
     report.search.evaluations += again.evaluations;
-    const bool hold = report.refine.covariance_ok && !all_observable;
-    candidates.emplace_back(
-        hold ? KeepObservableAxes(state_, again.state, report.refine.observable) : again.state,
-        "search from the last healthy estimate");
+    add_candidate(again.state, "search from the last healthy estimate", hold_search);
   }
   report.after = state_;
   report.reason = "no candidate scored better: estimate kept";
@@ -176,11 +170,6 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
     report.after = candidate;
     report.accepted = true;
     report.reason = name;
-    if (name.rfind("refined", 0) == 0) {
-      for (int k = 0; k < kNumAxes; ++k) {
-        if (!report.refine.observable[k]) report.reason += std::string(", held ") + kAxisNames[k];
-      }
-    }
   }
   // While tracking, move only part of the way (a first-order filter over frames): single windows
   // scatter, their average does not. A lost estimate jumps.
