@@ -93,6 +93,9 @@ CalibrateJob CalibrateJobFromFlags() {
   o.coarse_until_window_full = FLAGS_coarse_until_window_full;
   o.wait_for_full_window = FLAGS_wait_for_full_window;
   o.search_from_last_healthy = FLAGS_search_from_last_healthy;
+  o.lost_grid_deg = FLAGS_lost_grid_deg;
+  o.lost_grid_step_deg = FLAGS_lost_grid_step_deg;
+  o.point_margin = FLAGS_point_margin;
   o.score.horizontal_weight = FLAGS_horizontal_weight;
   o.search.alpha1_rotation_deg = FLAGS_alpha1_rotation_deg;
   o.search.alpha2_translation_m = FLAGS_alpha2_translation_m;
@@ -119,6 +122,7 @@ CalibrateJob CalibrateJobFromFlags() {
   job.source.local_map.use_ndt = FLAGS_use_ndt;
   job.source.lidar.remove_dynamic = FLAGS_remove_dynamic;
   job.source.suppress_texture = FLAGS_suppress_texture;
+  job.source.bandpass_score = FLAGS_bandpass_score;
   job.source.oriented_maps = FLAGS_oriented_maps;
   job.convergence.check_suppressed_health = FLAGS_check_suppressed_health;
   job.convergence.health_check.min_health = FLAGS_min_health;

@@ -76,3 +76,11 @@ DEFINE_bool(wait_for_full_window, true,
             "calibrate: no update before the search window holds --window_frames frames");
 DEFINE_bool(search_from_last_healthy, true,
             "calibrate: when lost, also search from the last healthy estimate");
+DEFINE_double(lost_grid_deg, 0.0,
+              "calibrate: when lost, first an exhaustive rotation grid of +-this [deg] (0 = none)");
+DEFINE_double(lost_grid_step_deg, 0.5, "calibrate: step of that grid [deg]");
+DEFINE_bool(bandpass_score, false,
+            "calibrate: with --suppress_texture, score on the band-pass IDT (not clipped at 0)");
+DEFINE_double(point_margin, 0.02,
+              "calibrate: LiDAR edge points are kept when they project inside the image shrunk by "
+              "this share of its size (negative: grown) at the estimate when their frame arrives");

@@ -75,7 +75,7 @@ cv::Mat InverseDistanceTransform(const cv::Mat& distance_px, double basin_px, do
   return idt;
 }
 
-cv::Mat SuppressTexture(const cv::Mat& idt, double sigma_px) {
+cv::Mat BandPass(const cv::Mat& idt, double sigma_px) {
   // The wide blur at a quarter of the resolution costs ~1/16 of a full-size one.
   const double scale = sigma_px >= 8 ? 0.25 : 1.0;
   cv::Mat small, blurred;
@@ -83,8 +83,12 @@ cv::Mat SuppressTexture(const cv::Mat& idt, double sigma_px) {
   cv::GaussianBlur(small, small, cv::Size(), sigma_px * scale, sigma_px * scale,
                    cv::BORDER_REPLICATE);
   cv::resize(small, blurred, idt.size(), 0, 0, cv::INTER_LINEAR);
-  cv::Mat out = idt - blurred;
-  cv::max(out, 0.0, out);
+  return idt - blurred;
+}
+
+cv::Mat SuppressTexture(const cv::Mat& idt, double sigma_px) {
+  cv::Mat out;
+  cv::max(BandPass(idt, sigma_px), 0.0, out);
   return out;
 }
 
@@ -129,6 +133,7 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     features.distance_px = embed(crop.distance_px, CV_32F, options.basin_px);
     features.idt = embed(crop.idt, CV_32F, 0);
     features.idt_suppressed = embed(crop.idt_suppressed, CV_32F, 0);
+    features.idt_bandpass = embed(crop.idt_bandpass, CV_32F, 0);
     for (size_t i = 0; i < options.pyramid_basins_px.size(); ++i) {
       features.idt_pyramid.push_back(
           embed(i < crop.idt_pyramid.size() ? crop.idt_pyramid[i] : cv::Mat(), CV_32F, 0));
@@ -172,6 +177,7 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     }
     features.idt = cv::Mat::zeros(gray.size(), CV_32F);
     features.idt_suppressed = features.idt.clone();
+    features.idt_bandpass = features.idt.clone();
     for (size_t i = 0; i < options.pyramid_basins_px.size(); ++i) {
       features.idt_pyramid.push_back(features.idt.clone());
     }
@@ -195,7 +201,8 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
   }
   const cv::Mat& distance = features.distance_raw_px;
   features.idt = InverseDistanceTransform(distance, options.basin_px, options.smoothing_sigma_px);
-  features.idt_suppressed = SuppressTexture(features.idt, options.suppression_sigma_px);
+  features.idt_bandpass = BandPass(features.idt, options.suppression_sigma_px);
+  cv::max(features.idt_bandpass, 0.0, features.idt_suppressed);
   for (double basin : options.pyramid_basins_px) {
     cv::Mat level =
         InverseDistanceTransform(distance, basin, std::max(options.smoothing_sigma_px, basin / 10));
@@ -212,7 +219,8 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     for (int o = 0; o < 2; ++o) {
       OrientedMaps& m = features.oriented[o];
       m.idt = InverseDistanceTransform(*raw[o], options.basin_px, options.smoothing_sigma_px);
-      m.idt_suppressed = SuppressTexture(m.idt, options.suppression_sigma_px);
+      m.idt_bandpass = BandPass(m.idt, options.suppression_sigma_px);
+      cv::max(m.idt_bandpass, 0.0, m.idt_suppressed);
       cv::min(*raw[o], options.basin_px, m.distance_px);
       Smooth(&m.distance_px, options.smoothing_sigma_px);
       for (double basin : options.pyramid_basins_px) {

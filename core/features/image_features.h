@@ -49,6 +49,7 @@ struct ImageFeatureOptions {
 struct OrientedMaps {
   cv::Mat idt;                   ///< CV_32F, smoothed IDT in [0, 255]
   cv::Mat idt_suppressed;        ///< texture-suppressed IDT
+  cv::Mat idt_bandpass;          ///< IDT − wide blur, not clipped (see BandPass)
   cv::Mat distance_px;           ///< smoothed min(D, basin) [px]
   std::vector<cv::Mat> pyramid;  ///< IDTs at pyramid_basins_px (suppressed if asked)
 };
@@ -61,6 +62,7 @@ struct ImageFeatures {
   cv::Mat distance_horizontal_raw_px;  ///< to near-horizontal edge pixels [px] (split_orientation)
   cv::Mat idt;                         ///< CV_32F, smoothed IDT in [0, 255]
   cv::Mat idt_suppressed;  ///< CV_32F, max(0, IDT − wide blur of IDT): dense texture fades
+  cv::Mat idt_bandpass;    ///< CV_32F, IDT − wide blur of IDT, not clipped (see BandPass)
   std::vector<cv::Mat> idt_pyramid;  ///< IDTs at pyramid_basins_px (suppressed if asked)
   std::vector<cv::Vec4f> segments;   ///< line segments at full-size coordinates (LSD/FLD)
   // With split_orientation: the maps of near-vertical [0] and near-horizontal [1] edges.
@@ -78,7 +80,14 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
 // IDT from a distance map: 255·max(0, 1 − D/basin), Gaussian-smoothed.
 cv::Mat InverseDistanceTransform(const cv::Mat& distance_px, double basin_px, double sigma_px);
 
-// Subtracts a wide blur (computed at reduced resolution) and clips at zero.
+// IDT minus its wide blur (computed at reduced resolution): a band-pass map with zero mean over
+// any patch much wider than sigma_px. Dense texture (foliage) averages to zero, an isolated edge
+// is a peak in a negative moat. As a score it does not reward moving points into edge-dense
+// regions; the clipped form (SuppressTexture) keeps the positive half of the texture and does
+// (on the shared KITTI frames the clipped map's score still rose towards +6° pitch, the band-pass
+// map peaks at KITTI's calibration in every roll/pitch/yaw slice).
+cv::Mat BandPass(const cv::Mat& idt, double sigma_px);
+// max(0, BandPass(idt, sigma_px)).
 cv::Mat SuppressTexture(const cv::Mat& idt, double sigma_px);
 
 }  // namespace stcalib

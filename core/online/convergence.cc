@@ -26,8 +26,12 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   ConvergenceVerdict verdict;
   verdict.estimate = calibrator.state();
 
-  // Aliasing guard over δ and the rotation-axis profiles, on the last search window.
-  WindowScorer scorer(calibrator.SearchWindow(), online.score);
+  // Aliasing guard over δ and the rotation-axis profiles, on the refinement's frames (the
+  // longest window the calibrator keeps: a sharp score's profile over 3 frames is noisy).
+  const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
+  std::vector<const CalibrationFrame*> profile_frames;
+  for (const auto& frame : recent) profile_frames.push_back(frame.get());
+  WindowScorer scorer(profile_frames, online.score);
   verdict.time_offset_profile =
       ProfileTimeOffset(&scorer, verdict.estimate, online.time_offset_bound_s, 0.0025);
   for (int axis = 0; axis < 3; ++axis) {
@@ -99,6 +103,11 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
     verdict.reason = "not converged: " + std::to_string(verdict.used_frames) +
                      " usable frame(s) cannot show that the estimate has settled (" +
                      std::to_string(options.min_frames) + " needed)";
+  } else if (calibrator.acquiring()) {
+    verdict.reason =
+        "not converged: still acquiring (the rotation grid around the initial "
+        "calibration has not yet agreed with the estimate on a full window of " +
+        std::to_string(online.refine_frames) + " frames)";
   } else if (at_time_bound || at_rotation_bound) {
     std::snprintf(text, sizeof(text),
                   "not converged: the estimate ran to the bound of its %s: the score has no "
@@ -129,7 +138,6 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   if (!verdict.converged || !options.check_suppressed_health) return verdict;
 
   // The independent check on the texture-suppressed maps of the last frames.
-  std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
   const size_t keep = std::min<size_t>(recent.size(), options.check_frames);
   std::vector<std::shared_ptr<const CalibrationFrame>> frames;
   for (size_t k = recent.size() - keep; k < recent.size(); ++k) {

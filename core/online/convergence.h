@@ -20,9 +20,12 @@ struct ConvergenceOptions {
   double min_final_health = 0.8;           ///< health of the last window at the estimate
   double rotation_bound_margin_deg = 0.5;  ///< this close to the search bound = "ran to it"
   double time_bound_margin_s = 0.0025;     ///< this close to the δ bound = "ran to it"
-  // Per rotation axis the last window's score must peak within this of the estimate, with no
-  // second peak of 90 % (ProfileRotationAxis over ±4°).
-  double max_profile_offset_deg = 0.5;
+  // Per rotation axis the score of the refinement's frames (up to 10) must peak within this of
+  // the estimate — one step of the 0.25° profile — with no second peak of 90 %
+  // (ProfileRotationAxis over ±4°). Measured: the estimates on KITTI and on simulated urban
+  // drives sit on the peak (offset 0); a street of poles, whose signs give a second alignment 3°
+  // off, peaks 0.5° away on roll.
+  double max_profile_offset_deg = 0.3;
   // An independent check of the estimate on the texture-suppressed maps of the last
   // `check_frames` frames (windows of HealthCheckOptions::window_frames): foliage makes a plain
   // map's optimum degrees off look healthy, the suppressed maps do not (measured on KITTI: an

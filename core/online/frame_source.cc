@@ -53,7 +53,9 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
     const std::vector<cv::Mat>& pyramid = m ? m->pyramid : out->image.idt_pyramid;
     for (const cv::Mat& level : pyramid) out->score_maps[kind].push_back(level);
     const cv::Mat& idt = m ? m->idt : out->image.idt;
-    const cv::Mat& suppressed = m ? m->idt_suppressed : out->image.idt_suppressed;
+    const cv::Mat& suppressed = options_.bandpass_score
+                                    ? (m ? m->idt_bandpass : out->image.idt_bandpass)
+                                    : (m ? m->idt_suppressed : out->image.idt_suppressed);
     out->score_maps[kind].push_back(options_.suppress_texture ? suppressed : idt);
     out->gray_map[kind] = idt;
     out->distance_px[kind] = m ? m->distance_px : out->image.distance_px;

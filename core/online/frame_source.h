@@ -16,7 +16,11 @@ struct FrameSourceOptions {
   LidarFeatureOptions lidar;
   LocalMapOptions local_map;
   bool suppress_texture = false;  ///< score maps are the texture-suppressed IDTs
-  bool oriented_maps = true;      ///< vertical/horizontal LiDAR edges read their own maps
+  // With suppress_texture: the finest score map is the band-pass IDT (not clipped at zero, see
+  // BandPass) rather than the clipped one. The health check keeps the clipped maps its
+  // thresholds were measured on.
+  bool bandpass_score = false;
+  bool oriented_maps = true;  ///< vertical/horizontal LiDAR edges read their own maps
   // A frame whose image time lies in a longer gap between oxts packets (or further from the
   // nearest one) is refused: its motion model would be a guess [s].
   double max_oxts_gap_s = 0.25;

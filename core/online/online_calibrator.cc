@@ -122,7 +122,30 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
                          (options_.coarse_until_window_full &&
                           static_cast<int>(frames.size()) < options_.window_frames);
   search_options.first_level = report.coarse_search ? 0 : scorer.num_levels() - 1;
-  report.search = AdaptiveGridSearch(&scorer, state_, anchor_, search_options);
+  CalibrationState search_start = state_;
+  int grid_evaluations = 0;
+  const bool acquiring = options_.acquire_with_grid && acquiring_;
+  bool grid_agrees = false;
+  if ((report.coarse_search || acquiring) && options_.lost_grid_deg > 0) {
+    WindowScorer grid_scorer(refine_frames, options_.score);
+    // Around the initial calibration: the truth lies within the start's error of it, whatever
+    // side peak the estimate may have climbed since.
+    const RotationGridResult grid =
+        RotationGridSearch(&grid_scorer, anchor_, anchor_, search_options, options_.lost_grid_deg,
+                           options_.lost_grid_step_deg);
+    grid_evaluations = grid.evaluations;
+    grid_agrees =
+        RotationErrorDeg(grid.state.T_camera_lidar.linear(), state_.T_camera_lidar.linear()) <
+        options_.lost_grid_step_deg + 1e-6;
+    search_start = grid.state;
+    search_options.first_level = scorer.num_levels() - 1;
+  }
+  if (acquiring && grid_agrees &&
+      static_cast<int>(refine_frames.size()) >= options_.refine_frames) {
+    acquiring_ = false;
+  }
+  report.search = AdaptiveGridSearch(&scorer, search_start, anchor_, search_options);
+  report.search.evaluations += grid_evaluations;
   report.search_ms = MillisecondsSince(start);
 
   // Refine from the search result, with a weak prior towards it.

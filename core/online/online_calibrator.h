@@ -32,6 +32,15 @@ struct OnlineCalibratorOptions {
   // Points are kept when they project inside the image shrunk by this share of its size on
   // each side, at the estimate when their frame arrives.
   double point_margin = 0.02;
+  // When lost, first an exhaustive rotation grid of ±lost_grid_deg at lost_grid_step_deg around
+  // the estimate on the finest map of the refinement's frames (RotationGridSearch); the search
+  // then starts from its best point on the finest map. 0 = no grid.
+  double lost_grid_deg = 0.0;
+  double lost_grid_step_deg = 0.5;
+  // Acquisition: from the start, the grid runs on every frame (not only when lost) until, on a
+  // full refinement window, its best point agrees with the estimate within one grid step. A few
+  // frames can have their global optimum far off; the frames a full window holds do not.
+  bool acquire_with_grid = true;
   // When lost, also search from the last healthy estimate and offer the result as a candidate.
   bool search_from_last_healthy = true;
   // While tracking (not lost), an accepted update moves this share of the way to the new
@@ -77,6 +86,11 @@ class OnlineCalibrator {
   // A frame the caller could not load: recorded as skipped with `why`.
   FrameReport SkipFrame(int frame, const std::string& why) const;
   const CalibrationState& state() const { return state_; }
+  // Still acquiring (OnlineCalibratorOptions::acquire_with_grid with a grid): the rotation grid
+  // has not yet agreed with the estimate on a full refinement window.
+  bool acquiring() const {
+    return options_.acquire_with_grid && options_.lost_grid_deg > 0 && acquiring_;
+  }
   // Replaces the estimate (the paper's disturbance protocol); the bounds stay where they were.
   void SetState(const CalibrationState& state) { state_ = state; }
   // The frames the last search used (the latest window_frames).
@@ -92,6 +106,7 @@ class OnlineCalibrator {
   CalibrationState anchor_;  ///< the initial calibration: the search's bounds are around it
   // The latest estimate whose health reached lost_health after a full window: when the estimate
   // is lost, a search from there is a candidate too (a disturbance or a wrong jump).
+  bool acquiring_ = true;  ///< see OnlineCalibratorOptions::acquire_with_grid
   bool has_last_healthy_ = false;
   CalibrationState last_healthy_;
   std::deque<std::shared_ptr<const CalibrationFrame>> window_;  // the last refine_frames frames

@@ -162,6 +162,35 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
   return result;
 }
 
+RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationState& center,
+                                      const CalibrationState& anchor,
+                                      const AdaptiveGridSearchOptions& options,
+                                      double half_range_deg, double step_deg, int level) {
+  CHECK(half_range_deg >= 0 && step_deg > 0) << half_range_deg << " " << step_deg;
+  RotationGridResult result;
+  result.state = center;
+  result.score = scorer->Evaluate(center, level).score;
+  result.evaluations = 1;
+  const int n = static_cast<int>(std::floor(half_range_deg / step_deg + 1e-9));
+  for (int a = -n; a <= n; ++a) {
+    for (int b = -n; b <= n; ++b) {
+      for (int c = -n; c <= n; ++c) {
+        if (a == 0 && b == 0 && c == 0) continue;
+        const CalibrationState candidate = Step(
+            center, Eigen::Vector3d(a, b, c) * step_deg * kDegToRad, Eigen::Vector3d::Zero(), 0.0);
+        if (!WithinBounds(candidate, anchor, options)) continue;
+        const double value = scorer->Evaluate(candidate, level).score;
+        ++result.evaluations;
+        if (value > result.score) {
+          result.score = value;
+          result.state = candidate;
+        }
+      }
+    }
+  }
+  return result;
+}
+
 namespace {
 
 // Best and second local maximum (at least min_separation away) of a 1-D score profile.
@@ -214,7 +243,7 @@ TimeOffsetProfile ProfileTimeOffset(WindowScorer* scorer, const CalibrationState
 
 RotationAxisProfile ProfileRotationAxis(WindowScorer* scorer, const CalibrationState& state,
                                         int axis, double half_range_deg, double step_deg,
-                                        double ratio, double min_separation_deg) {
+                                        double ratio, double min_separation_deg, int level) {
   CHECK(axis >= 0 && axis < 3) << "rotation axis " << axis;
   RotationAxisProfile profile;
   for (double d = -half_range_deg; d <= half_range_deg + 1e-9; d += step_deg) {
@@ -222,7 +251,7 @@ RotationAxisProfile ProfileRotationAxis(WindowScorer* scorer, const CalibrationS
     r[axis] = d * M_PI / 180.0;
     profile.offsets_deg.push_back(d);
     profile.scores.push_back(
-        scorer->Evaluate(Step(state, r, Eigen::Vector3d::Zero(), 0.0), -1).score);
+        scorer->Evaluate(Step(state, r, Eigen::Vector3d::Zero(), 0.0), level).score);
   }
   if (profile.scores.empty()) return profile;
   const PeakStats peaks = FindPeaks(profile.offsets_deg, profile.scores, min_separation_deg);

@@ -57,6 +57,21 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
                                 const CalibrationState& anchor,
                                 const AdaptiveGridSearchOptions& options);
 
+// Exhaustive rotation grid: roll, pitch and yaw offsets in [−half_range_deg, half_range_deg] at
+// step_deg about the LiDAR axes (translation and δ as in `center`), scored on `level`, inside
+// the bounds around `anchor`. The first stage when the estimate is lost: the band-pass score's
+// peak is narrow (about ±1° on KITTI) but global, so a dense grid finds it where a local search
+// from 2° away climbs a side peak.
+struct RotationGridResult {
+  CalibrationState state;  ///< the best grid point (`center` when nothing scored better)
+  double score = 0;        ///< its score on `level`
+  int evaluations = 0;
+};
+RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationState& center,
+                                      const CalibrationState& anchor,
+                                      const AdaptiveGridSearchOptions& options,
+                                      double half_range_deg, double step_deg, int level = -1);
+
 // True when `state` is within the rotation/translation bounds around `anchor`.
 bool WithinBounds(const CalibrationState& state, const CalibrationState& anchor,
                   const AdaptiveGridSearchOptions& options);
@@ -88,6 +103,6 @@ struct RotationAxisProfile {
 RotationAxisProfile ProfileRotationAxis(WindowScorer* scorer, const CalibrationState& state,
                                         int axis, double half_range_deg = 4.0,
                                         double step_deg = 0.25, double ratio = 0.9,
-                                        double min_separation_deg = 1.0);
+                                        double min_separation_deg = 1.0, int level = -1);
 
 }  // namespace stcalib
