@@ -81,6 +81,40 @@ TEST(ImageFeatures, BlackImageGivesEmptyFeaturesNotACrash) {
   EXPECT_TRUE(ExtractImageFeatures(cv::Mat(), options).empty());
 }
 
+// The band-pass map (BandPass) averages to zero over dense texture, so moving points into a
+// textured region gains nothing; the clipped map (SuppressTexture) keeps the positive half-wave
+// and rewards it. An isolated edge is a positive peak in both.
+TEST(ImageFeatures, BandPassIsZeroMeanOnTextureAndPeaksOnAnIsolatedEdge) {
+  cv::Mat image(240, 320, CV_8UC3, cv::Scalar::all(90));
+  cv::RNG rng(7);
+  for (int k = 0; k < 120; ++k) {  // "foliage" on the left: small leaves, edges every few pixels
+    const cv::Point c(rng.uniform(0, 160), rng.uniform(60, 180));
+    cv::circle(image, c, rng.uniform(2, 5), cv::Scalar::all(rng.uniform(0, 2) ? 20 : 200),
+               cv::FILLED);
+  }
+  cv::rectangle(image, cv::Rect(230, 80, 40, 80), cv::Scalar::all(220), cv::FILLED);  // isolated
+  ImageFeatureOptions options;
+  const ImageFeatures f = ExtractImageFeatures(image, options);
+  ASSERT_FALSE(f.empty());
+  // Clipped form = max(0, band-pass).
+  cv::Mat clipped;
+  cv::max(f.idt_bandpass, 0.0, clipped);
+  EXPECT_LT(cv::norm(clipped, f.idt_suppressed, cv::NORM_INF), 1e-3);
+  const cv::Rect inner(40, 90, 80, 60);  // well inside the texture
+  const double bandpass_mean = cv::mean(f.idt_bandpass(inner))[0];
+  const double clipped_mean = cv::mean(f.idt_suppressed(inner))[0];
+  const double idt_mean = cv::mean(f.idt(inner))[0];
+  std::printf("texture: IDT mean %.1f, clipped %.1f, band-pass %.1f\n", idt_mean, clipped_mean,
+              bandpass_mean);
+  // Measured: IDT 215, clipped 10.5, band-pass 0.1 grey levels.
+  EXPECT_LT(std::abs(bandpass_mean), 0.02 * idt_mean);
+  EXPECT_GT(clipped_mean, 5.0);
+  EXPECT_LT(std::abs(bandpass_mean), 0.2 * clipped_mean);
+  // On the isolated rectangle's left side (x = 230), the band-pass value is a clear peak.
+  EXPECT_GT(f.idt_bandpass.at<float>(120, 230), 0.3 * 255);
+  EXPECT_GT(f.idt_bandpass.at<float>(120, 230), f.idt_bandpass.at<float>(120, 200) + 50);
+}
+
 TEST(ImageFeatures, LineDetectorsFindSegmentsOnKitti) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
