@@ -8,6 +8,7 @@
 
 #include "core/online/frame_source.h"
 #include "core/online/online_calibrator.h"
+#include "core/search/adaptive_grid_search.h"
 
 namespace stcalib {
 namespace {
@@ -62,6 +63,23 @@ void BM_OnlineUpdate(benchmark::State& state) {
   state.SetLabel("refine over " + std::to_string(state.range(0)) + " frames, search over 3");
 }
 BENCHMARK(BM_OnlineUpdate)->Arg(3)->Arg(10)->Unit(benchmark::kMillisecond);
+
+// The acquisition's rotation grid (±3° at 0.5°: 13³ = 2197 candidates) over N frames; it runs
+// on every frame while acquiring and when lost, not while tracking.
+void BM_RotationGrid(benchmark::State& state) {
+  if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
+  CalibrationState initial;
+  initial.T_camera_lidar = Kitti().drive.T_camera_lidar;
+  std::vector<const CalibrationFrame*> frames;
+  for (int i = 0; i < state.range(0); ++i) frames.push_back(Kitti().frames[i].get());
+  WindowScorer scorer(frames, ScoreOptions());
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        RotationGridSearch(&scorer, initial, initial, AdaptiveGridSearchOptions(), 3.0, 0.5));
+  }
+  state.SetLabel("2197 rotations over " + std::to_string(state.range(0)) + " frames");
+}
+BENCHMARK(BM_RotationGrid)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
 
 // Image features, LiDAR features and local map for one new frame (sweeps before it cached).
 void BM_FrameFeatures(benchmark::State& state) {
