@@ -126,12 +126,13 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   int grid_evaluations = 0;
   const bool acquiring = options_.acquire_with_grid && acquiring_;
   bool grid_agrees = false;
+  // The refinement's frames: the grid's window and the judge of the candidates.
+  WindowScorer long_scorer(refine_frames, options_.score);
   if ((report.coarse_search || acquiring) && options_.lost_grid_deg > 0) {
-    WindowScorer grid_scorer(refine_frames, options_.score);
     // Around the initial calibration: the truth lies within the start's error of it, whatever
     // side peak the estimate may have climbed since.
     const RotationGridResult grid =
-        RotationGridSearch(&grid_scorer, anchor_, anchor_, search_options, options_.lost_grid_deg,
+        RotationGridSearch(&long_scorer, anchor_, anchor_, search_options, options_.lost_grid_deg,
                            options_.lost_grid_step_deg);
     grid_evaluations = grid.evaluations;
     grid_agrees =
@@ -157,7 +158,6 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   // Acceptance, judged on all the refinement's frames (a longer and steadier window than the
   // search's): the best of the refined estimate (unobservable axes held) and the search result,
   // when it scores at least as well as the current estimate.
-  WindowScorer long_scorer(refine_frames, options_.score);
   const double before_long = long_scorer.Evaluate(state_, -1).score;
   std::vector<std::pair<CalibrationState, std::string>> candidates;
   // A candidate keeps the axes the refinement found unobservable where they were: a degenerate
