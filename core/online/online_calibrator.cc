@@ -129,15 +129,24 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   // The refinement's frames: the grid's window and the judge of the candidates.
   WindowScorer long_scorer(refine_frames, options_.score);
   if ((report.coarse_search || acquiring) && options_.lost_grid_deg > 0) {
-    // Around the initial calibration: the truth lies within the start's error of it, whatever
-    // side peak the estimate may have climbed since.
+    // Rotations around the initial calibration's (the truth lies within the start's error of
+    // it, whatever side peak the estimate may have climbed since), with the estimate's
+    // translation and δ (a stale δ or translation would shift the grid's best rotation).
+    CalibrationState centre = state_;
+    centre.T_camera_lidar.linear() = anchor_.T_camera_lidar.linear();
     const RotationGridResult grid =
-        RotationGridSearch(&long_scorer, anchor_, anchor_, search_options, options_.lost_grid_deg,
+        RotationGridSearch(&long_scorer, centre, anchor_, search_options, options_.lost_grid_deg,
                            options_.lost_grid_step_deg);
     grid_evaluations = grid.evaluations;
+    // Agreement: the estimate is within one lattice step (diagonals included) of the grid's
+    // best point, i.e. on the same peak.
     grid_agrees =
         RotationErrorDeg(grid.state.T_camera_lidar.linear(), state_.T_camera_lidar.linear()) <
-        options_.lost_grid_step_deg + 1e-6;
+        std::sqrt(3.0) * options_.lost_grid_step_deg + 1e-6;
+    VLOG(1) << "frame " << frame->index << ": rotation grid best "
+            << RotationErrorDeg(grid.state.T_camera_lidar.linear(),
+                                state_.T_camera_lidar.linear())
+            << " deg from the estimate over " << refine_frames.size() << " frames";
     search_start = grid.state;
     search_options.first_level = scorer.num_levels() - 1;
   }

@@ -38,7 +38,8 @@ struct OnlineCalibratorOptions {
   double lost_grid_deg = 0.0;
   double lost_grid_step_deg = 0.5;
   // Acquisition: from the start, the grid runs on every frame (not only when lost) until, on a
-  // full refinement window, its best point agrees with the estimate within one grid step. A few
+  // full refinement window, its best point agrees with the estimate within one grid step (on
+  // each axis; √3 steps in all). A few
   // frames can have their global optimum far off; the frames a full window holds do not.
   bool acquire_with_grid = true;
   // When lost, also search from the last healthy estimate and offer the result as a candidate.
