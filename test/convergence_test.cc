@@ -21,13 +21,11 @@ TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
   // ones; any drive may still be calibrated on them).
   FrameSourceOptions options;
   options.suppress_texture = false;
-  std::unique_ptr<DriveFrameSource> source;
-  ASSERT_TRUE(DriveFrameSource::Create(&drive, options, &source).ok());
-  std::vector<std::shared_ptr<const CalibrationFrame>> plain, suppressed;
-  for (int i = 21; i <= 29; ++i) {
-    auto frame = std::make_shared<CalibrationFrame>();
-    ASSERT_TRUE(source->Load(i, frame.get()).ok());
-    plain.push_back(frame);
+  const std::vector<std::shared_ptr<const CalibrationFrame>> plain =
+      testing::LoadCalibrationFrames(drive, options, {21, 22, 23, 24, 25, 26, 27, 28, 29});
+  ASSERT_EQ(plain.size(), 9u);
+  std::vector<std::shared_ptr<const CalibrationFrame>> suppressed;
+  for (const auto& frame : plain) {
     suppressed.push_back(WithSuppressedScoreMaps(*frame));
     ASSERT_EQ(suppressed.back()->score_maps[0].size(), 1u);
     ASSERT_EQ(suppressed.back()->size(), frame->size());
@@ -55,12 +53,6 @@ TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
   EXPECT_GE(plain_wrong.mean_health, 0.8);
 }
 
-}  // namespace
-}  // namespace stcalib
-
-namespace stcalib {
-namespace {
-
 // The texture trap of method.md §10 and its cure: on the shared KITTI frames the clipped
 // texture-suppressed score still rises for degrees away from KITTI's calibration (moving points
 // into foliage pays), the band-pass score peaks at the calibration on every rotation axis.
@@ -71,16 +63,14 @@ TEST(Score, KittiBandPassPeaksAtTheCalibrationTheClippedMapDoesNot) {
   FrameSourceOptions options;
   options.suppress_texture = true;
   options.bandpass_score = true;
-  std::unique_ptr<DriveFrameSource> source;
-  ASSERT_TRUE(DriveFrameSource::Create(&drive, options, &source).ok());
   CalibrationState kitti;
   kitti.T_camera_lidar = drive.T_camera_lidar;
+  std::vector<int> every_second;
+  for (size_t i = 0; i < drive.NumFrames(); i += 2) every_second.push_back(static_cast<int>(i));
   std::vector<std::shared_ptr<const CalibrationFrame>> bandpass, clipped;
-  for (size_t i = 0; i < drive.NumFrames(); i += 2) {
-    CalibrationFrame frame;
-    ASSERT_TRUE(source->Load(i, &frame).ok());
+  for (const auto& frame : testing::LoadCalibrationFrames(drive, options, every_second)) {
     // Points a little outside the image too: a band-pass map is near zero there on average.
-    bandpass.push_back(PruneToImage(frame, kitti, -0.1));
+    bandpass.push_back(PruneToImage(*frame, kitti, -0.1));
     clipped.push_back(WithSuppressedScoreMaps(*bandpass.back()));
   }
   auto view = [](const std::vector<std::shared_ptr<const CalibrationFrame>>& frames) {

@@ -15,15 +15,9 @@ namespace {
 std::vector<std::shared_ptr<const CalibrationFrame>> LoadKittiFrames(const Drive& drive, int n) {
   FrameSourceOptions options;
   options.suppress_texture = true;
-  std::unique_ptr<DriveFrameSource> source;
-  EXPECT_TRUE(DriveFrameSource::Create(&drive, options, &source).ok());
-  std::vector<std::shared_ptr<const CalibrationFrame>> frames;
-  for (int i = 0; i < n; ++i) {
-    auto frame = std::make_shared<CalibrationFrame>();
-    EXPECT_TRUE(source->Load(i, frame.get()).ok());
-    frames.push_back(frame);
-  }
-  return frames;
+  std::vector<int> indices(n);
+  for (int i = 0; i < n; ++i) indices[i] = i;
+  return testing::LoadCalibrationFrames(drive, options, indices);
 }
 
 // A rotation of `deg` about a random axis (the seed picks it).

@@ -55,4 +55,20 @@ std::string MakeTinyDrive(const std::string& root, int num_frames) {
   return drive;
 }
 
+std::vector<std::shared_ptr<const CalibrationFrame>> LoadCalibrationFrames(
+    const Drive& drive, const FrameSourceOptions& options, const std::vector<int>& indices) {
+  std::vector<std::shared_ptr<const CalibrationFrame>> frames;
+  std::unique_ptr<DriveFrameSource> source;
+  const Status created = DriveFrameSource::Create(&drive, options, &source);
+  EXPECT_TRUE(created.ok()) << created.message();
+  if (!created.ok()) return frames;
+  for (int i : indices) {
+    auto frame = std::make_shared<CalibrationFrame>();
+    const Status loaded = source->Load(i, frame.get());
+    EXPECT_TRUE(loaded.ok()) << loaded.message();
+    if (loaded.ok()) frames.push_back(frame);
+  }
+  return frames;
+}
+
 }  // namespace stcalib::testing

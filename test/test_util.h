@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/io/drive.h"
+#include "core/online/frame_source.h"
 
 namespace stcalib::testing {
 
@@ -61,5 +62,10 @@ inline void WriteFile(const std::string& path, const std::string& contents) {
 // Writes a small, valid KITTI-layout drive (calibration copied from fixed KITTI-like values)
 // into root/2011_01_01/2011_01_01_drive_0001_sync and returns the drive folder.
 std::string MakeTinyDrive(const std::string& root, int num_frames);
+
+// Frames `indices` of `drive` as CalibrationFrames built with `options`; a frame that does not
+// load is a test failure (and is left out).
+std::vector<std::shared_ptr<const CalibrationFrame>> LoadCalibrationFrames(
+    const Drive& drive, const FrameSourceOptions& options, const std::vector<int>& indices);
 
 }  // namespace stcalib::testing

@@ -124,11 +124,11 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   search_options.first_level = report.coarse_search ? 0 : scorer.num_levels() - 1;
   CalibrationState search_start = state_;
   int grid_evaluations = 0;
-  const bool acquiring = options_.acquire_with_grid && acquiring_;
+  const bool was_acquiring = acquiring();
   bool grid_agrees = false;
   // The refinement's frames: the grid's window and the judge of the candidates.
   WindowScorer long_scorer(refine_frames, options_.score);
-  if ((report.coarse_search || acquiring) && options_.lost_grid_deg > 0) {
+  if ((report.coarse_search || was_acquiring) && options_.lost_grid_deg > 0) {
     // Rotations around the initial calibration's (the truth lies within the start's error of
     // it, whatever side peak the estimate may have climbed since), with the estimate's
     // translation and δ (a stale δ or translation would shift the grid's best rotation).
@@ -140,17 +140,15 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
     grid_evaluations = grid.evaluations;
     // Agreement: the estimate is within one lattice step (diagonals included) of the grid's
     // best point, i.e. on the same peak.
-    grid_agrees =
-        RotationErrorDeg(grid.state.T_camera_lidar.linear(), state_.T_camera_lidar.linear()) <
-        std::sqrt(3.0) * options_.lost_grid_step_deg + 1e-6;
-    VLOG(1) << "frame " << frame->index << ": rotation grid best "
-            << RotationErrorDeg(grid.state.T_camera_lidar.linear(),
-                                state_.T_camera_lidar.linear())
+    const double grid_offset_deg =
+        RotationErrorDeg(grid.state.T_camera_lidar.linear(), state_.T_camera_lidar.linear());
+    grid_agrees = grid_offset_deg < std::sqrt(3.0) * options_.lost_grid_step_deg + 1e-6;
+    VLOG(1) << "frame " << frame->index << ": rotation grid best " << grid_offset_deg
             << " deg from the estimate over " << refine_frames.size() << " frames";
     search_start = grid.state;
     search_options.first_level = scorer.num_levels() - 1;
   }
-  if (acquiring && grid_agrees &&
+  if (was_acquiring && grid_agrees &&
       static_cast<int>(refine_frames.size()) >= options_.refine_frames) {
     acquiring_ = false;
   }
