@@ -137,6 +137,35 @@ TEST(ImageFeatures, LineDetectorsFindSegmentsOnKitti) {
   }
 }
 
+// A vertical step between columns c−1 and c has its edge at x = c − 0.5 (pixel centres at
+// integers). LSD run at half resolution must report it there too: the coordinates of the
+// reduced image are mapped back centre to centre, not just scaled.
+TEST(ImageFeatures, LsdSegmentsKeepPixelCentresAtReducedScale) {
+  for (double scale : {1.0, 0.5}) {
+    double sum = 0;
+    int found = 0;
+    for (int column = 100; column < 104; ++column) {
+      cv::Mat image(200, 300, CV_8UC1, cv::Scalar(40));
+      image(cv::Rect(column, 0, 300 - column, 200)).setTo(200);
+      ImageFeatureOptions options;
+      options.detector = ImageFeatureOptions::Detector::kLsd;
+      options.line_scale = scale;
+      const ImageFeatures f = ExtractImageFeatures(image, options);
+      for (const cv::Vec4f& s : f.segments) {
+        if (std::abs(s[3] - s[1]) < 100 || std::abs(s[2] - s[0]) > 1) continue;  // the long one
+        const double error = 0.5 * (s[0] + s[2]) - (column - 0.5);
+        std::printf("scale %.1f edge x=%.1f: segment x error %+.2f px\n", scale, column - 0.5,
+                    error);
+        EXPECT_LT(std::abs(error), 0.75);
+        sum += error;
+        ++found;
+      }
+    }
+    ASSERT_EQ(found, 4) << "scale " << scale;
+    EXPECT_LT(std::abs(sum / found), 0.3) << "scale " << scale;
+  }
+}
+
 TEST(LidarRings, KittiFramesHaveSixtyFourRingsTopToBottom) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;

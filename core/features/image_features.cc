@@ -39,8 +39,12 @@ std::vector<cv::Vec4f> DetectSegments(const cv::Mat& gray, const ImageFeatureOpt
         options.canny_high, /*canny_aperture_size=*/3, /*do_merge=*/false);
     fld->detect(small, segments);
   }
+  // Pixel centres: small pixel i covers full pixels [i/scale, (i+1)/scale), so its centre is at
+  // full coordinate (i + 0.5)/scale − 0.5 (scaling alone would shift every segment by
+  // 0.5·(1/scale − 1) px towards the origin: half a pixel at scale 0.5).
   const float inv = static_cast<float>(1.0 / options.line_scale);
-  for (cv::Vec4f& s : segments) s *= inv;
+  const float shift = 0.5f * (inv - 1.0f);
+  for (cv::Vec4f& s : segments) s = s * inv + cv::Vec4f(shift, shift, shift, shift);
   return segments;
 }
 
