@@ -63,24 +63,34 @@ FrameReport OnlineCalibrator::SkipFrame(int frame, const std::string& why) const
   return report;
 }
 
-FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> frame) {
-  std::string why;
-  const bool finite_motion = std::isfinite(frame->e0_s) && std::isfinite(frame->camera_time_s) &&
-                             frame->twist.linear_m_s.allFinite() &&
-                             frame->twist.angular_rad_s.allFinite();
-  if (!finite_motion) {
-    why = "non-finite stamp gap or motion";
-  } else if (!(frame->camera_time_s > last_camera_time_s_)) {
-    why = "image stamp not after the previous frame's (duplicated or out of order)";
-  } else if (frame->image.empty() || frame->distance_px[0].empty() ||
-             frame->distance_px[1].empty()) {
-    why = "no image edges (black, blank or unreadable image)";
+std::vector<const CalibrationFrame*> OnlineCalibrator::RefineWindow() const {
+  std::vector<const CalibrationFrame*> frames;
+  const size_t n = std::min<size_t>(window_.size(), options_.refine_frames);
+  for (size_t k = window_.size() - n; k < window_.size(); ++k) frames.push_back(window_[k].get());
+  return frames;
+}
+
+std::string OnlineCalibrator::RefusalReason(const CalibrationFrame& frame) const {
+  const bool finite_motion = std::isfinite(frame.e0_s) && std::isfinite(frame.camera_time_s) &&
+                             frame.twist.linear_m_s.allFinite() &&
+                             frame.twist.angular_rad_s.allFinite();
+  if (!finite_motion) return "non-finite stamp gap or motion";
+  if (!(frame.camera_time_s > last_camera_time_s_)) {
+    return "image stamp not after the previous frame's (duplicated or out of order)";
   }
+  if (frame.image.empty() || frame.distance_px[0].empty() || frame.distance_px[1].empty()) {
+    return "no image edges (black, blank or unreadable image)";
+  }
+  return "";
+}
+
+FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> frame) {
+  const std::string why = RefusalReason(*frame);
   if (!why.empty()) return SkipFrame(frame->index, why);
   last_camera_time_s_ = frame->camera_time_s;
   FrameReport report;
   report.frame = frame->index;
-  report.before = state_;
+  report.before = report.after = state_;
   window_.push_back(PruneToImage(*frame, state_, options_.point_margin));
   while (static_cast<int>(window_.size()) >
          std::max(options_.window_frames, options_.refine_frames)) {
@@ -88,129 +98,39 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   }
   const std::vector<const CalibrationFrame*> frames = SearchWindow();
   for (const CalibrationFrame* f : frames) report.points += static_cast<int>(f->size());
-  std::vector<const CalibrationFrame*> refine_frames;
-  for (size_t k = window_.size() > static_cast<size_t>(options_.refine_frames)
-                      ? window_.size() - options_.refine_frames
-                      : 0;
-       k < window_.size(); ++k) {
-    refine_frames.push_back(window_[k].get());
-  }
   if (report.points < 30) {
     report.reason = "too few LiDAR edge points in the image (" + std::to_string(report.points) +
                     "): estimate kept";
-    report.after = state_;
     return report;
   }
   WindowScorer scorer(frames, options_.score);
   report.score_before = scorer.Evaluate(state_, -1);
+  report.gray_rate_before = scorer.GrayRate(state_);
+  report.health_before = HealthScore(&scorer, state_);
   if (options_.wait_for_full_window && static_cast<int>(frames.size()) < options_.window_frames) {
     report.reason = "window filling (" + std::to_string(frames.size()) + " of " +
                     std::to_string(options_.window_frames) + " frames): estimate kept";
-    report.after = state_;
     report.score_after = report.score_before;
-    report.gray_rate_before = report.gray_rate_after = scorer.GrayRate(state_);
-    report.health_before = report.health = HealthScore(&scorer, state_);
+    report.gray_rate_after = report.gray_rate_before;
+    report.health = report.health_before;
     return report;
   }
-
-  // Search: coarse-to-fine when lost, the finest map alone when tracking.
-  auto start = std::chrono::steady_clock::now();
-  AdaptiveGridSearchOptions search_options = options_.search;
-  report.gray_rate_before = scorer.GrayRate(state_);
-  report.health_before = HealthScore(&scorer, state_);
+  // Coarse-to-fine from the widest map when lost or while the window fills, else the finest map.
   report.coarse_search = report.health_before < options_.lost_health ||
                          (options_.coarse_until_window_full &&
                           static_cast<int>(frames.size()) < options_.window_frames);
-  search_options.first_level = report.coarse_search ? 0 : scorer.num_levels() - 1;
-  CalibrationState search_start = state_;
-  int grid_evaluations = 0;
-  const bool was_acquiring = acquiring();
-  bool grid_agrees = false;
+  const std::vector<const CalibrationFrame*> refine_frames = RefineWindow();
   // The refinement's frames: the grid's window and the judge of the candidates.
   WindowScorer long_scorer(refine_frames, options_.score);
-  if ((report.coarse_search || was_acquiring) && options_.lost_grid_deg > 0) {
-    // Rotations around the initial calibration's (the truth lies within the start's error of
-    // it, whatever side peak the estimate may have climbed since), with the estimate's
-    // translation and δ (a stale δ or translation would shift the grid's best rotation).
-    CalibrationState centre = state_;
-    centre.T_camera_lidar.linear() = anchor_.T_camera_lidar.linear();
-    const RotationGridResult grid =
-        RotationGridSearch(&long_scorer, centre, anchor_, search_options, options_.lost_grid_deg,
-                           options_.lost_grid_step_deg);
-    grid_evaluations = grid.evaluations;
-    // Agreement: the estimate is within one lattice step (diagonals included) of the grid's
-    // best point, i.e. on the same peak.
-    const double grid_offset_deg =
-        RotationErrorDeg(grid.state.T_camera_lidar.linear(), state_.T_camera_lidar.linear());
-    grid_agrees = grid_offset_deg < std::sqrt(3.0) * options_.lost_grid_step_deg + 1e-6;
-    VLOG(1) << "frame " << frame->index << ": rotation grid best " << grid_offset_deg
-            << " deg from the estimate over " << refine_frames.size() << " frames";
-    search_start = grid.state;
-    search_options.first_level = scorer.num_levels() - 1;
-  }
-  if (was_acquiring && grid_agrees &&
-      static_cast<int>(refine_frames.size()) >= options_.refine_frames) {
-    acquiring_ = false;
-  }
-  report.search = AdaptiveGridSearch(&scorer, search_start, anchor_, search_options);
-  report.search.evaluations += grid_evaluations;
-  report.search_ms = MillisecondsSince(start);
+  AdaptiveGridSearchOptions search_options = options_.search;
+  Search(&scorer, &long_scorer, &search_options, &report);
 
-  // Refine from the search result, with a weak prior towards it.
-  start = std::chrono::steady_clock::now();
+  const auto start = std::chrono::steady_clock::now();
   report.refine =
       Refine(refine_frames, report.search.state, report.search.state, anchor_, options_.refine);
   report.refine_ms = MillisecondsSince(start);
 
-  // Acceptance, judged on all the refinement's frames (a longer and steadier window than the
-  // search's): the best of the refined estimate (unobservable axes held) and the search result,
-  // when it scores at least as well as the current estimate.
-  const double before_long = long_scorer.Evaluate(state_, -1).score;
-  std::vector<std::pair<CalibrationState, std::string>> candidates;
-  // A candidate keeps the axes the refinement found unobservable where they were: a degenerate
-  // scene (open road, poles only) must not move what it cannot see. Without a covariance the
-  // refined estimate cannot move and the search results move freely.
-  std::string held;
-  for (int k = 0; k < kNumAxes; ++k) {
-    if (!report.refine.observable[k]) held += std::string(", held ") + kAxisNames[k];
-  }
-  auto add_candidate = [&](const CalibrationState& candidate, const std::string& name, bool hold) {
-    candidates.emplace_back(
-        hold ? KeepObservableAxes(state_, candidate, report.refine.observable) : candidate,
-        hold ? name + held : name);
-  };
-  const bool hold_search = report.refine.covariance_ok && !held.empty();
-  if (report.refine.usable) add_candidate(report.refine.state, "refined", true);
-  add_candidate(report.search.state, "search", hold_search);
-  if (options_.search_from_last_healthy && report.coarse_search && has_last_healthy_ &&
-      RotationErrorDeg(last_healthy_.T_camera_lidar.linear(), state_.T_camera_lidar.linear()) >
-          options_.search.alpha3_rotation_deg) {
-    const SearchResult again = AdaptiveGridSearch(&scorer, last_healthy_, anchor_, search_options);
-    report.search.evaluations += again.evaluations;
-    add_candidate(again.state, "search from the last healthy estimate", hold_search);
-  }
-  report.after = state_;
-  report.reason = "no candidate scored better: estimate kept";
-  double best = before_long;
-  for (const auto& [candidate, name] : candidates) {
-    if (!WithinBounds(candidate, anchor_, search_options)) continue;
-    const double value = long_scorer.Evaluate(candidate, -1).score;
-    if (value < best) continue;
-    best = value;
-    report.after = candidate;
-    report.accepted = true;
-    report.reason = name;
-  }
-  // While tracking, move only part of the way (a first-order filter over frames): single windows
-  // scatter, their average does not. A lost estimate jumps.
-  if (report.accepted && !report.coarse_search && options_.tracking_gain < 1.0) {
-    const CalibrationState& c = report.after;
-    const double g = options_.tracking_gain;
-    report.after = Step(
-        state_, g * LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear()),
-        g * (c.T_camera_lidar.translation() - state_.T_camera_lidar.translation()),
-        g * (c.time_offset_s - state_.time_offset_s));
-  }
+  Choose(Candidates(&scorer, search_options, &report), &long_scorer, search_options, &report);
   report.score_after = scorer.Evaluate(report.after, -1);
   state_ = report.after;
   report.gray_rate_after = scorer.GrayRate(state_);
@@ -222,6 +142,101 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
     last_healthy_ = state_;
   }
   return report;
+}
+
+void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
+                              AdaptiveGridSearchOptions* search_options, FrameReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  search_options->first_level = report->coarse_search ? 0 : scorer->num_levels() - 1;
+  CalibrationState search_start = state_;
+  int grid_evaluations = 0;
+  const bool was_acquiring = acquiring();
+  bool grid_agrees = false;
+  if ((report->coarse_search || was_acquiring) && options_.lost_grid_deg > 0) {
+    // Rotations around the initial calibration's (the truth lies within the start's error of
+    // it, whatever side peak the estimate may have climbed since), with the estimate's
+    // translation and δ (a stale δ or translation would shift the grid's best rotation).
+    CalibrationState centre = state_;
+    centre.T_camera_lidar.linear() = anchor_.T_camera_lidar.linear();
+    const RotationGridResult grid =
+        RotationGridSearch(long_scorer, centre, anchor_, *search_options, options_.lost_grid_deg,
+                           options_.lost_grid_step_deg);
+    grid_evaluations = grid.evaluations;
+    // Agreement: the estimate is within one lattice step (diagonals included) of the grid's
+    // best point, i.e. on the same peak.
+    const double grid_offset_deg =
+        RotationErrorDeg(grid.state.T_camera_lidar.linear(), state_.T_camera_lidar.linear());
+    grid_agrees = grid_offset_deg < std::sqrt(3.0) * options_.lost_grid_step_deg + 1e-6;
+    VLOG(1) << "frame " << report->frame << ": rotation grid best " << grid_offset_deg
+            << " deg from the estimate over " << long_scorer->num_frames() << " frames";
+    search_start = grid.state;
+    search_options->first_level = scorer->num_levels() - 1;
+  }
+  if (was_acquiring && grid_agrees &&
+      static_cast<int>(long_scorer->num_frames()) >= options_.refine_frames) {
+    acquiring_ = false;
+  }
+  report->search = AdaptiveGridSearch(scorer, search_start, anchor_, *search_options);
+  report->search.evaluations += grid_evaluations;
+  report->search_ms = MillisecondsSince(start);
+}
+
+std::vector<OnlineCalibrator::Candidate> OnlineCalibrator::Candidates(
+    WindowScorer* scorer, const AdaptiveGridSearchOptions& search_options,
+    FrameReport* report) const {
+  // A candidate keeps the axes the refinement found unobservable where they were: a degenerate
+  // scene (open road, poles only) must not move what it cannot see. Without a covariance the
+  // refined estimate cannot move and the search results move freely.
+  std::string held;
+  for (int k = 0; k < kNumAxes; ++k) {
+    if (!report->refine.observable[k]) held += std::string(", held ") + kAxisNames[k];
+  }
+  std::vector<Candidate> candidates;
+  auto add = [&](const CalibrationState& candidate, const std::string& name, bool hold) {
+    candidates.push_back(
+        {hold ? KeepObservableAxes(state_, candidate, report->refine.observable) : candidate,
+         hold ? name + held : name});
+  };
+  const bool hold_search = report->refine.covariance_ok && !held.empty();
+  if (report->refine.usable) add(report->refine.state, "refined", true);
+  add(report->search.state, "search", hold_search);
+  if (options_.search_from_last_healthy && report->coarse_search && has_last_healthy_ &&
+      RotationErrorDeg(last_healthy_.T_camera_lidar.linear(), state_.T_camera_lidar.linear()) >
+          options_.search.alpha3_rotation_deg) {
+    const SearchResult again = AdaptiveGridSearch(scorer, last_healthy_, anchor_, search_options);
+    report->search.evaluations += again.evaluations;
+    add(again.state, "search from the last healthy estimate", hold_search);
+  }
+  return candidates;
+}
+
+void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowScorer* long_scorer,
+                              const AdaptiveGridSearchOptions& search_options,
+                              FrameReport* report) const {
+  // Judged on all the refinement's frames (a longer and steadier window than the search's): the
+  // best candidate within the bounds, when it scores at least as well as the current estimate.
+  report->after = state_;
+  report->reason = "no candidate scored better: estimate kept";
+  double best = long_scorer->Evaluate(state_, -1).score;
+  for (const Candidate& candidate : candidates) {
+    if (!WithinBounds(candidate.state, anchor_, search_options)) continue;
+    const double value = long_scorer->Evaluate(candidate.state, -1).score;
+    if (value < best) continue;
+    best = value;
+    report->after = candidate.state;
+    report->accepted = true;
+    report->reason = candidate.name;
+  }
+  // While tracking, move only part of the way (a first-order filter over frames): single windows
+  // scatter, their average does not. A lost estimate jumps.
+  if (report->accepted && !report->coarse_search && options_.tracking_gain < 1.0) {
+    const CalibrationState& c = report->after;
+    const double g = options_.tracking_gain;
+    report->after = Step(
+        state_, g * LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear()),
+        g * (c.T_camera_lidar.translation() - state_.T_camera_lidar.translation()),
+        g * (c.time_offset_s - state_.time_offset_s));
+  }
 }
 
 }  // namespace stcalib

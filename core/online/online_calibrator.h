@@ -102,12 +102,35 @@ class OnlineCalibrator {
   }
 
  private:
+  // An estimate offered to the judge, and the reason given when it is taken.
+  struct Candidate {
+    CalibrationState state;
+    std::string name;
+  };
+
+  // The steps of AddFrame.
+  std::string RefusalReason(const CalibrationFrame& frame) const;  ///< empty when usable
+  std::vector<const CalibrationFrame*> RefineWindow() const;       ///< latest refine_frames
+  // Rotation grid (when lost or acquiring; ends acquisition when it agrees with the estimate on
+  // a full window) then the adaptive search: fills report->search and search_ms.
+  void Search(WindowScorer* scorer, WindowScorer* long_scorer,
+              AdaptiveGridSearchOptions* search_options, FrameReport* report);
+  // The refined estimate, the search result and, when lost, a search from the last healthy
+  // estimate; the axes the refinement found unobservable held.
+  std::vector<Candidate> Candidates(WindowScorer* scorer,
+                                    const AdaptiveGridSearchOptions& search_options,
+                                    FrameReport* report) const;
+  // The best candidate within the bounds that scores at least as well as the estimate on the
+  // refinement's frames, moved by tracking_gain while tracking: fills report->after.
+  void Choose(const std::vector<Candidate>& candidates, WindowScorer* long_scorer,
+              const AdaptiveGridSearchOptions& search_options, FrameReport* report) const;
+
   OnlineCalibratorOptions options_;
   CalibrationState state_;
   CalibrationState anchor_;  ///< the initial calibration: the search's bounds are around it
+  bool acquiring_ = true;    ///< see OnlineCalibratorOptions::acquire_with_grid
   // The latest estimate whose health reached lost_health after a full window: when the estimate
   // is lost, a search from there is a candidate too (a disturbance or a wrong jump).
-  bool acquiring_ = true;  ///< see OnlineCalibratorOptions::acquire_with_grid
   bool has_last_healthy_ = false;
   CalibrationState last_healthy_;
   std::deque<std::shared_ptr<const CalibrationFrame>> window_;  // the last refine_frames frames
