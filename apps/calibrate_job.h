@@ -18,6 +18,7 @@ struct CalibrateJob {
   int first_frame = 0, num_frames = 0;
   int disturb_frame = -1;
   double disturb_rot_deg = 2.0;
+  bool polish = true;  ///< OnlineCalibrator::Polish() after the last frame
   OnlineCalibratorOptions online;
   FrameSourceOptions source;
   ConvergenceOptions convergence;
@@ -33,6 +34,7 @@ struct CalibrateOutcome {
   CalibrationState reference_state, initial, estimate;
   CalibrationError error, initial_error;
   std::vector<FrameReport> reports;
+  FrameReport polish;  ///< the final refinement (OnlineCalibrator::Polish), if run
   std::vector<std::string> pictures;
   double mean_frame_ms = 0;
 };

@@ -70,6 +70,18 @@ cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
 
 std::string Csv(const std::string& s) { return "\"" + s + "\""; }
 
+// What the final refinement (OnlineCalibrator::Polish) did.
+nlohmann::json PolishJson(const FrameReport& polish) {
+  const Eigen::Vector3d dt =
+      polish.after.T_camera_lidar.translation() - polish.before.T_camera_lidar.translation();
+  return {{"applied", polish.accepted},
+          {"reason", polish.reason},
+          {"rotation_change_deg", RotationErrorDeg(polish.before.T_camera_lidar.linear(),
+                                                   polish.after.T_camera_lidar.linear())},
+          {"translation_change_m", dt.norm()},
+          {"time_offset_change_s", polish.after.time_offset_s - polish.before.time_offset_s}};
+}
+
 }  // namespace
 
 CalibrateJob CalibrateJobFromFlags() {
@@ -86,6 +98,7 @@ CalibrateJob CalibrateJobFromFlags() {
   job.num_frames = FLAGS_num_frames;
   job.disturb_frame = FLAGS_disturb_frame;
   job.disturb_rot_deg = FLAGS_disturb_rot_deg;
+  job.polish = FLAGS_polish;
   OnlineCalibratorOptions& o = job.online;
   o.window_frames = FLAGS_window_frames;
   o.time_offset_bound_s = FLAGS_time_offset_bound_s;
@@ -231,12 +244,13 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   }
   if (job.progress && isatty(fileno(stderr))) std::fprintf(stderr, "\n");
   outcome->mean_frame_ms = frame_ms_sum / std::max(1, frames_used);
-  outcome->estimate = calibrator.state();
-  outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
-
-  // The verdict (core/online/convergence.h): the app only formats it.
+  // The verdict, and the polish of a converged estimate (core/online/convergence.h): the app
+  // only formats them.
   const ConvergenceVerdict verdict =
-      JudgeConvergence(calibrator, outcome->reports, initial, job.online, job.convergence);
+      JudgeAndPolish(&calibrator, outcome->reports, initial, job.online, job.convergence,
+                     job.polish ? &outcome->polish : nullptr);
+  if (!job.polish) outcome->polish.reason = "polish: off (--nopolish)";
+  LOG(INFO) << outcome->polish.reason;
   outcome->estimate = verdict.estimate;
   outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
   outcome->converged = verdict.converged;
@@ -264,10 +278,12 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   for (const FrameReport& r : outcome->reports) {
     if (!r.skipped) final_report_ptr = &r;
   }
-  const FrameReport& final_report = *final_report_ptr;
+  // The score, gray rate and health at the final estimate: the polish's when it was taken.
+  const FrameReport& final_report = outcome->polish.accepted ? outcome->polish : *final_report_ptr;
   const int skipped = verdict.skipped_frames;
   const std::vector<std::string>& unobservable = verdict.unobservable_axes;
-  const RefineResult& refine = final_report.refine;
+  // The covariance is the last frame's refinement's (the polish holds the translation).
+  const RefineResult& refine = final_report_ptr->refine;
 
   // Outputs.
   const std::string out = job.out_dir;
@@ -322,6 +338,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
         {"total",
          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run_start)
              .count()}}},
+      {"polish", PolishJson(outcome->polish)},
       {"reference", outcome->reference},
       {"initial_error", ErrorJson(outcome->initial_error)},
   };

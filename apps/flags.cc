@@ -76,6 +76,8 @@ DEFINE_bool(wait_for_full_window, true,
             "calibrate: no update before the search window holds --window_frames frames");
 DEFINE_bool(search_from_last_healthy, true,
             "calibrate: when lost, also search from the last healthy estimate");
+DEFINE_bool(polish, true,
+            "calibrate: refine the final estimate over the refinement's frames from itself");
 DEFINE_double(lost_grid_deg, 0.0,
               "calibrate: when lost, first an exhaustive rotation grid of +-this [deg] (0 = none)");
 DEFINE_double(lost_grid_step_deg, 0.5, "calibrate: step of that grid [deg]");

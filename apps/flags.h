@@ -60,6 +60,7 @@ DECLARE_double(eval_max_range_m);
 DECLARE_bool(coarse_until_window_full);
 DECLARE_bool(wait_for_full_window);
 DECLARE_bool(search_from_last_healthy);
+DECLARE_bool(polish);
 DECLARE_double(lost_grid_deg);
 DECLARE_double(lost_grid_step_deg);
 DECLARE_bool(bandpass_score);

@@ -52,8 +52,9 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                       ? used.size() - options.settle_frames
                       : 0;
        k < used.size(); ++k) {
+    // The online trajectory's own moves (a final polish is not a frame).
     settle_deg = std::max(settle_deg, RotationErrorDeg(used[k]->after.T_camera_lidar.linear(),
-                                                       verdict.estimate.T_camera_lidar.linear()));
+                                                       last.after.T_camera_lidar.linear()));
   }
 
   // Axes the last refinement could not pin down were held: they go back to the start (earlier
@@ -150,6 +151,30 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
     verdict.reason = "not converged: the check on texture-suppressed maps of the last " +
                      std::to_string(keep) + " frames says " + verdict.health_check.reason;
   }
+  return verdict;
+}
+
+ConvergenceVerdict JudgeAndPolish(OnlineCalibrator* calibrator,
+                                  const std::vector<FrameReport>& reports,
+                                  const CalibrationState& initial,
+                                  const OnlineCalibratorOptions& online,
+                                  const ConvergenceOptions& options, FrameReport* polish) {
+  ConvergenceVerdict verdict = JudgeConvergence(*calibrator, reports, initial, online, options);
+  if (polish == nullptr) return verdict;
+  *polish = FrameReport();
+  polish->before = polish->after = calibrator->state();
+  if (!verdict.converged) {
+    polish->reason = "polish: not run (the online estimate did not converge)";
+    return verdict;
+  }
+  *polish = calibrator->Polish();
+  if (!polish->accepted) return verdict;
+  ConvergenceVerdict polished = JudgeConvergence(*calibrator, reports, initial, online, options);
+  if (polished.converged) return polished;
+  calibrator->SetState(polish->before);
+  polish->after = polish->before;
+  polish->accepted = false;
+  polish->reason += "; undone, the polished estimate did not converge (" + polished.reason + ")";
   return verdict;
 }
 

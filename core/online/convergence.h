@@ -54,6 +54,17 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                                     const OnlineCalibratorOptions& online,
                                     const ConvergenceOptions& options);
 
+// The verdict on the online estimate and, when it converged, on its polish
+// (OnlineCalibrator::Polish): the polished estimate is kept only when it converges too, else the
+// calibrator goes back to the online estimate and `polish` says why. A polish can refine a
+// converged estimate, never turn a refusal into a claim (a wrong peak can be refined onto the
+// score's peak, as on a street of poles). `polish` may be null: no polish.
+ConvergenceVerdict JudgeAndPolish(OnlineCalibrator* calibrator,
+                                  const std::vector<FrameReport>& reports,
+                                  const CalibrationState& initial,
+                                  const OnlineCalibratorOptions& online,
+                                  const ConvergenceOptions& options, FrameReport* polish);
+
 // A view of `frame` whose only score map per edge kind is its texture-suppressed IDT.
 std::shared_ptr<const CalibrationFrame> WithSuppressedScoreMaps(const CalibrationFrame& frame);
 

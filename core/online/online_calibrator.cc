@@ -136,11 +136,51 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   report.gray_rate_after = scorer.GrayRate(state_);
   // The health of an unchanged estimate is the one measured before.
   report.health = report.accepted ? HealthScore(&scorer, state_) : report.health_before;
+  last_health_ = report.health;
   if (report.health >= options_.lost_health &&
       static_cast<int>(frames.size()) >= options_.window_frames) {
     has_last_healthy_ = true;
     last_healthy_ = state_;
   }
+  return report;
+}
+
+FrameReport OnlineCalibrator::Polish() {
+  FrameReport report;
+  report.frame = -1;
+  report.before = report.after = state_;
+  const std::vector<const CalibrationFrame*> frames = RefineWindow();
+  if (frames.empty() || acquiring() || last_health_ < options_.lost_health) {
+    report.reason = frames.empty() ? "polish: no frames"
+                    : acquiring()  ? "polish: still acquiring"
+                                   : "polish: the last window is not healthy";
+    return report;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  // Rotation only (see the header).
+  RefineOptions refine_options = options_.refine;
+  refine_options.estimate_translation = false;
+  refine_options.estimate_time_offset = false;
+  report.refine = Refine(frames, state_, state_, anchor_, refine_options);
+  report.refine_ms = MillisecondsSince(start);
+  if (!report.refine.usable) {
+    report.reason = "polish: refinement failed (" + report.refine.message + ")";
+    return report;
+  }
+  const CalibrationState polished =
+      KeepObservableAxes(state_, report.refine.state, report.refine.observable);
+  if (!WithinBounds(polished, anchor_, options_.search)) {
+    report.reason = "polish: the refined estimate leaves the bounds";
+    return report;
+  }
+  report.after = state_ = polished;
+  report.accepted = true;
+  report.reason = "polish: refined over " + std::to_string(frames.size()) + " frames";
+  // Score, gray rate and health at the polished estimate, on the search window like a frame's.
+  WindowScorer scorer(SearchWindow(), options_.score);
+  report.score_after = scorer.Evaluate(state_, -1);
+  report.gray_rate_after = scorer.GrayRate(state_);
+  report.health = last_health_ = HealthScore(&scorer, state_);
   return report;
 }
 

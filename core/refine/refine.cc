@@ -48,9 +48,16 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
   double delta =
       std::clamp(start.time_offset_s, -options.time_offset_bound_s, options.time_offset_bound_s);
   ceres::Problem problem;
-  problem.AddParameterBlock(
-      pose, 7,
-      new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>());
+  if (options.estimate_translation) {
+    problem.AddParameterBlock(
+        pose, 7,
+        new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>());
+  } else {
+    problem.AddParameterBlock(
+        pose, 7,
+        new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::SubsetManifold>(
+            ceres::EigenQuaternionManifold(), ceres::SubsetManifold(3, {0, 1, 2})));
+  }
   problem.AddParameterBlock(&delta, 1);
   ceres::LossFunction* loss =
       options.loss == RefineOptions::Loss::kCauchy
@@ -142,7 +149,11 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
   std::vector<const double*> blocks = {pose};
   if (options.estimate_time_offset) blocks.push_back(&delta);
   if (covariance.Compute(blocks, &problem)) {
-    const int n = options.estimate_time_offset ? 7 : 6;
+    // Tangent coordinates → axes: rotation (3), translation (3) when estimated, δ when estimated.
+    std::vector<int> axis_of = {0, 1, 2};
+    if (options.estimate_translation) axis_of.insert(axis_of.end(), {3, 4, 5});
+    if (options.estimate_time_offset) axis_of.push_back(6);
+    const int n = static_cast<int>(axis_of.size());
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(n, n);
     if (covariance.GetCovarianceMatrixInTangentSpace(blocks, C.data())) {
       const double dof = std::max(1, result.residuals - n);
@@ -161,10 +172,13 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
       J(6, 6) = 1.0;
       Eigen::Matrix<double, kNumAxes, kNumAxes> full =
           Eigen::Matrix<double, kNumAxes, kNumAxes>::Zero();
-      full.topLeftCorner(n, n) = C * sigma2;
+      for (int a = 0; a < n; ++a) {
+        for (int b = 0; b < n; ++b) full(axis_of[a], axis_of[b]) = C(a, b) * sigma2;
+      }
       const Eigen::Matrix<double, kNumAxes, kNumAxes> axes = J * full * J.transpose();
       for (int k = 0; k < kNumAxes; ++k) result.std_dev[k] = std::sqrt(std::max(0.0, axes(k, k)));
       if (!options.estimate_time_offset) result.std_dev[6] = 0;
+      if (!options.estimate_translation) result.std_dev.segment<3>(3).setZero();
       for (int a = 0; a < kNumAxes; ++a) {
         for (int b = 0; b < kNumAxes; ++b) {
           const double d = result.std_dev[a] * result.std_dev[b];
@@ -194,6 +208,9 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
     result.observable[k] = result.covariance_ok && result.std_dev[k] < thresholds[k];
   }
   if (!options.estimate_time_offset) result.observable[6] = false;
+  if (!options.estimate_translation) {
+    for (int k = 3; k < 6; ++k) result.observable[k] = false;
+  }
   return result;
 }
 

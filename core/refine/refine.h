@@ -31,6 +31,7 @@ struct RefineOptions {
   double prior_sigma_time_s = 0.03;   ///< [s]
   double time_offset_bound_s = 0.15;  ///< |δ| bound [s]
   bool estimate_time_offset = true;
+  bool estimate_translation = true;  ///< false: the translation stays at the start's
   int max_points_per_frame = 300;
   int max_iterations = 12;
   // Observability thresholds on the standard deviations.
