@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstring>
@@ -394,6 +395,26 @@ TEST(Cli, SimulateRejectsBadFlags) {
 namespace stcalib {
 namespace {
 
+// A numeric column of per_frame.csv (they all come before the quoted reason) in data row `row`;
+// NaN when absent.
+double PerFrameNumber(const std::string& csv, size_t row, const std::string& column) {
+  auto fields = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::istringstream in(line);
+    for (std::string field; std::getline(in, field, ',');) out.push_back(field);
+    return out;
+  };
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = fields(line);
+  const auto it = std::find(header.begin(), header.end(), column);
+  for (size_t k = 0; it != header.end() && std::getline(in, line); ++k) {
+    if (k == row) return std::stod(fields(line).at(it - header.begin()));
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
 // `calibrate --flagfile=configs/kitti.flags` from ±2° on roll, pitch and yaw (issue 5's KITTI
 // protocol) on the shared frames.
 RunResult CalibrateKitti(const std::string& out, const std::string& args) {
@@ -402,7 +423,7 @@ RunResult CalibrateKitti(const std::string& out, const std::string& args) {
 }
 
 // All 30 frames: the rotation grid finds the band-pass peak, the calibration converges near
-// KITTI's own (measured 0.30–0.46° over seeds 1–4, nearly all roll).
+// KITTI's own (measured 0.25–0.32° over seeds 1–4 after the polish, nearly all roll).
 TEST(Cli, CalibratesKittiFromTwoDegrees) {
   STCALIB_REQUIRE_KITTI();
   testing::ScopedTempDir tmp;
@@ -412,10 +433,17 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
   const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
   const auto& agreement = result["agreement_with_drive_calibration"];
   EXPECT_TRUE(result["converged"].get<bool>()) << result["reason"];
-  EXPECT_LT(agreement["rotation_deg"].get<double>(), 0.5) << r.output;
+  // Measured 0.28° (the online estimate was 0.20° off; the polish moved it 0.11° to the
+  // refinement's optimum, which over these frames lies 0.25-0.32° from KITTI's on roll).
+  EXPECT_LT(agreement["rotation_deg"].get<double>(), 0.35) << r.output;
   EXPECT_LT(agreement["translation_m"].get<double>(), 0.05) << r.output;
   EXPECT_LT(std::abs(result["time_offset_s"].get<double>()), 0.01) << r.output;
   EXPECT_TRUE(std::filesystem::exists(out + "/calib_velo_to_cam.txt"));
+  EXPECT_TRUE(result["polish"]["applied"].get<bool>()) << result["polish"]["reason"];
+  // The first frames find the calibration's peak, not a side peak 4-6° off (measured 0.71° at
+  // the fifth frame from a 3.46° start).
+  EXPECT_LT(PerFrameNumber(testing::ReadFile(out + "/per_frame.csv"), 4, "rotation_error_deg"),
+            1.0);
 }
 
 // Twelve frames from frame 10: these frames prefer a side peak 3.5° off; before the grid has
