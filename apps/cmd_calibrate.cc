@@ -250,7 +250,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       JudgeAndPolish(&calibrator, outcome->reports, initial, job.online, job.convergence,
                      job.polish ? &outcome->polish : nullptr);
   if (!job.polish) outcome->polish.reason = "polish: off (--nopolish)";
-  LOG(INFO) << outcome->polish.reason;
+  VLOG(1) << outcome->polish.reason;
   outcome->estimate = verdict.estimate;
   outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
   outcome->converged = verdict.converged;
