@@ -59,6 +59,9 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
     out->score_maps[kind].push_back(options_.suppress_texture ? suppressed : idt);
     out->gray_map[kind] = idt;
     out->distance_px[kind] = m ? m->distance_px : out->image.distance_px;
+    double max_value = 0;
+    if (!out->distance_px[kind].empty()) cv::minMaxLoc(out->distance_px[kind], nullptr, &max_value);
+    out->distance_cap_px = std::max(out->distance_cap_px, max_value);
   }
 
   LidarEdges map;

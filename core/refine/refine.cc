@@ -67,16 +67,18 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
     if (frame->distance_px[0].empty() || frame->distance_px[1].empty() || frame->size() == 0)
       continue;
     const DistanceInterpolator* by_kind[2];
-    double cap = 0;
+    double cap = frame->distance_cap_px;
     for (int kind = 0; kind < 2; ++kind) {
       const cv::Mat& map = frame->distance_px[kind];
       CHECK(map.isContinuous() && map.type() == CV_32F);
       grids.push_back(std::make_unique<DistanceGrid>(map.ptr<float>(), 0, map.rows, 0, map.cols));
       interpolators.push_back(std::make_unique<DistanceInterpolator>(*grids.back()));
       by_kind[kind] = interpolators.back().get();
-      double max_value = 0;
-      cv::minMaxLoc(map, nullptr, &max_value);
-      cap = std::max(cap, max_value);
+      if (frame->distance_cap_px <= 0) {  // not known: one pass over the map
+        double max_value = 0;
+        cv::minMaxLoc(map, nullptr, &max_value);
+        cap = std::max(cap, max_value);
+      }
     }
     const size_t n = frame->size();
     const size_t keep =

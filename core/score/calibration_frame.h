@@ -33,6 +33,9 @@ struct CalibrationFrame {
   std::array<cv::Mat, 2> gray_map;
   // Smoothed, capped distance maps for the refinement's bicubic residuals [px].
   std::array<cv::Mat, 2> distance_px;
+  // The largest value of the two distance maps: the residual of a point outside the image [px];
+  // 0 = not yet known (the refinement then finds it).
+  double distance_cap_px = 0;
 
   size_t size() const { return points_lidar.size(); }
 };
