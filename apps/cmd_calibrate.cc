@@ -379,6 +379,18 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   }
   status = WriteTextFile(out + "/per_frame.csv", csv);
   if (!status.ok()) return fail(status);
+  // The polish, drawn as one more step after the last frame.
+  const bool polished = outcome->polish.accepted && !xs.empty();
+  if (polished) {
+    const CalibrationError e = outcome->error;
+    xs.push_back(xs.back() + 1);
+    rot_err.push_back(e.rotation_deg);
+    roll_e.push_back(e.roll_deg);
+    pitch_e.push_back(e.pitch_deg);
+    yaw_e.push_back(e.yaw_deg);
+    trans_err_cm.push_back(100 * e.translation_norm_m);
+    dt_ms.push_back(1000 * outcome->estimate.time_offset_s);
+  }
 
   const std::string vs =
       outcome->has_truth ? "error vs ground truth" : "difference from the drive calibration";
@@ -396,7 +408,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
                                std::to_string(1000 * outcome->reference_state.time_offset_s)
                                    .substr(0, 6) +
                                ")"
-                         : std::string()),
+                         : std::string()) +
+                    (polished ? "; each panel's last step: the polish" : ""),
                 xs, {{"delta", dt_ms, cv::Scalar(0, 120, 200)}})};
   cv::Mat convergence;
   cv::vconcat(panels, convergence);
