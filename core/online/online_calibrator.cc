@@ -131,12 +131,8 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   report.refine_ms = MillisecondsSince(start);
 
   Choose(Candidates(&scorer, search_options, &report), &long_scorer, search_options, &report);
-  report.score_after = scorer.Evaluate(report.after, -1);
   state_ = report.after;
-  report.gray_rate_after = scorer.GrayRate(state_);
-  // The health of an unchanged estimate is the one measured before.
-  report.health = report.accepted ? HealthScore(&scorer, state_) : report.health_before;
-  last_health_ = report.health;
+  MeasureEstimate(&scorer, report.accepted, &report);
   if (report.health >= options_.lost_health &&
       static_cast<int>(frames.size()) >= options_.window_frames) {
     has_last_healthy_ = true;
@@ -176,12 +172,18 @@ FrameReport OnlineCalibrator::Polish() {
   report.after = state_ = polished;
   report.accepted = true;
   report.reason = "polish: refined over " + std::to_string(frames.size()) + " frames";
-  // Score, gray rate and health at the polished estimate, on the search window like a frame's.
+  // On the search window, like a frame's.
   WindowScorer scorer(SearchWindow(), options_.score);
-  report.score_after = scorer.Evaluate(state_, -1);
-  report.gray_rate_after = scorer.GrayRate(state_);
-  report.health = last_health_ = HealthScore(&scorer, state_);
+  MeasureEstimate(&scorer, true, &report);
   return report;
+}
+
+void OnlineCalibrator::MeasureEstimate(WindowScorer* scorer, bool moved, FrameReport* report) {
+  report->score_after = scorer->Evaluate(state_, -1);
+  report->gray_rate_after = scorer->GrayRate(state_);
+  // The health of an unchanged estimate is the one measured before.
+  report->health = moved ? HealthScore(scorer, state_) : report->health_before;
+  last_health_ = report->health;
 }
 
 void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,

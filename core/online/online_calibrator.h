@@ -135,6 +135,9 @@ class OnlineCalibrator {
   void Choose(const std::vector<Candidate>& candidates, WindowScorer* long_scorer,
               const AdaptiveGridSearchOptions& search_options, FrameReport* report) const;
 
+  // Score, gray rate and health at the estimate (health_before reused when it did not move).
+  void MeasureEstimate(WindowScorer* scorer, bool moved, FrameReport* report);
+
   OnlineCalibratorOptions options_;
   CalibrationState state_;
   CalibrationState anchor_;  ///< the initial calibration: the search's bounds are around it
