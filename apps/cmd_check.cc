@@ -18,7 +18,6 @@ int RunCheck() {
   HealthCheckOptions options;
   options.window_frames = FLAGS_window_frames;
   options.min_health = FLAGS_min_health;
-  options.score.horizontal_weight = FLAGS_horizontal_weight;
   Status status = options.Validate();
   if (!status.ok()) return UsageError(kCommand, status.message());
   Drive drive;

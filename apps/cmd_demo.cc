@@ -46,7 +46,6 @@ int RunDemo() {
   job.perturb_time_s = 0.0;
   job.first_frame = 0;
   job.num_frames = 0;
-  job.source.suppress_texture = false;  // a clean simulated scene has no foliage to suppress
   std::printf("2/2 calibrating from +-2 deg on roll, pitch and yaw, +-5 cm, time offset 0\n");
   std::fflush(stdout);
   CalibrateOutcome outcome;

@@ -211,12 +211,15 @@ std::string SimulateDrive(const std::string& out, const std::string& args) {
   return SimulatedDrive(out);
 }
 
-// `calibrate` with configs/sim.flags from ±2° on each axis and ±5 cm (signs from `seed`).
-RunResult CalibrateFromTwoDegrees(const std::string& drive, const std::string& out, int seed) {
-  return RunStcalib(
-      "calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" + drive +
-      " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=" + std::to_string(seed) +
-      " --out=" + out);
+// `calibrate` with configs/sim.flags from ±2° on each axis and ±5 cm (signs from `seed`). The
+// default refinement spans 20 frames, and acquisition ends only when the rotation grid agrees
+// with the estimate on a full one: drives shorter than that get `kShortDrive`.
+constexpr char kShortDrive[] = " --refine_frames=10";
+RunResult CalibrateFromTwoDegrees(const std::string& drive, const std::string& out, int seed,
+                                  const std::string& extra_flags = "") {
+  return RunStcalib("calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" +
+                    drive + " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=" +
+                    std::to_string(seed) + " --out=" + out + extra_flags);
 }
 
 // Replaces line `index` (0-based) of a text file; `text` empty removes it.
@@ -237,7 +240,7 @@ void EditLine(const std::string& path, size_t index, const std::string* text) {
 
 TEST(Cli, CalibrateSkipsFaultyFramesKeepsTheEstimateAndRecovers) {
   testing::ScopedTempDir tmp;
-  const std::string drive = SimulateDrive(tmp.path(), "--frames=16 --seed=2 --time_offset_s=0.02");
+  const std::string drive = SimulateDrive(tmp.path(), "--frames=20 --seed=2 --time_offset_s=0.02");
   ASSERT_FALSE(drive.empty());
   // Frame 4: a burst of NaN points.
   {
@@ -286,7 +289,7 @@ TEST(Cli, CalibrateSkipsFaultyFramesKeepsTheEstimateAndRecovers) {
   std::filesystem::remove(drive + "/velodyne_points/labels/0000000014.bin");
 
   const std::string out = tmp.path() + "/out";
-  const RunResult r = CalibrateFromTwoDegrees(drive, out, 2);
+  const RunResult r = CalibrateFromTwoDegrees(drive, out, 2, kShortDrive);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   const std::string csv = testing::ReadFile(out + "/per_frame.csv");
   EXPECT_THAT(csv, HasSubstr("4,0,"));
@@ -312,7 +315,7 @@ TEST(Cli, CalibratesADriveWithoutOxtsFromScanRegistration) {
   ASSERT_FALSE(drive.empty());
   std::filesystem::remove_all(drive + "/oxts");
   const std::string out = tmp.path() + "/out";
-  const RunResult r = CalibrateFromTwoDegrees(drive, out, 3);
+  const RunResult r = CalibrateFromTwoDegrees(drive, out, 3, kShortDrive);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("no oxts; the motion comes from registering consecutive sweeps"));
   const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
@@ -331,7 +334,7 @@ TEST(Cli, DegenerateScenesAreReportedNeverAWrongSuccess) {
         tmp.path(), "--frames=12 --seed=4 --scene=" + scene + " --time_offset_s=0.02");
     ASSERT_FALSE(drive.empty());
     const std::string out = tmp.path() + "/out";
-    const RunResult r = CalibrateFromTwoDegrees(drive, out, 1);
+    const RunResult r = CalibrateFromTwoDegrees(drive, out, 1, kShortDrive);
     const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
     const bool converged = result["converged"].get<bool>();
     EXPECT_EQ(r.exit_code, converged ? 0 : 1) << r.output;
