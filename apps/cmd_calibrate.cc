@@ -108,6 +108,7 @@ CalibrateJob CalibrateJobFromFlags() {
   o.search_from_last_healthy = FLAGS_search_from_last_healthy;
   o.lost_grid_deg = FLAGS_lost_grid_deg;
   o.lost_grid_step_deg = FLAGS_lost_grid_step_deg;
+  o.acquire_time_offset = FLAGS_acquire_time_offset;
   o.point_margin = FLAGS_point_margin;
   o.score.horizontal_weight = FLAGS_horizontal_weight;
   o.search.alpha1_rotation_deg = FLAGS_alpha1_rotation_deg;
@@ -116,6 +117,8 @@ CalibrateJob CalibrateJobFromFlags() {
   o.search.alpha4_translation_m = FLAGS_alpha4_translation_m;
   o.search.gamma = FLAGS_gamma;
   o.search.search_time_offset = FLAGS_estimate_time_offset;
+  o.search.translation_prior_sigma_m = FLAGS_prior_sigma_translation_m;
+  o.search.time_offset_prior_sigma_s = FLAGS_prior_sigma_time_s;
   o.refine.estimate_time_offset = FLAGS_estimate_time_offset;
   o.refine.loss =
       FLAGS_loss == "huber" ? RefineOptions::Loss::kHuber : RefineOptions::Loss::kCauchy;
@@ -168,7 +171,6 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   status = ReadGroundTruth(drive, &outcome->has_truth, &outcome->reference_state);
   if (!status.ok()) return ReportError(kCommand, status);
   if (outcome->has_truth) {
-    if (!status.ok()) return ReportError(kCommand, status);
     outcome->reference = "ground truth (simulated)";
   } else {
     outcome->reference_state.T_camera_lidar = drive.T_camera_lidar;
@@ -324,6 +326,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"converged", outcome->converged},
       {"reason", outcome->reason},
       {"alias_suspect", outcome->alias_suspect},
+      {"time_offset_peak_s", profile.best_s},
       {"alias_second_peak_s", profile.second_peak_s},
       {"alias_second_peak_ratio", profile.second_peak_ratio},
       {"time_forward_correlation", refine.time_forward_correlation},

@@ -44,10 +44,10 @@ DEFINE_double(alpha4_translation_m, 0.01, "search: small translation step [m]");
 DEFINE_double(gamma, 0.45, "search: gray-rate threshold between the large and the small step pair");
 DEFINE_double(lost_health, 0.9, "calibrate: below this health the search goes coarse-to-fine");
 DEFINE_double(prior_sigma_rotation_deg, 2.0, "refine: weak rotation prior [deg]");
-DEFINE_double(prior_sigma_translation_m, 0.05, "refine: translation prior [m]");
+DEFINE_double(prior_sigma_translation_m, 0.05, "search and refine: translation prior around the start [m]");
 DEFINE_double(prior_sigma_forward_m, 0.05,
               "refine: translation prior along the direction of travel, per point [m]");
-DEFINE_double(prior_sigma_time_s, 0.03, "refine: time-offset prior towards δ0 [s]");
+DEFINE_double(prior_sigma_time_s, 0.03, "search and refine: time-offset prior around δ0 [s]");
 // A few frames can prefer a side peak 3.5 deg off (drive 0013, frames 10-16): refine on 20.
 DEFINE_int32(refine_frames, 20, "calibrate: latest frames in the refinement");
 DEFINE_int32(max_points_per_frame, 300, "refine: LiDAR edge points used per frame");
@@ -94,6 +94,8 @@ DEFINE_bool(polish, true,
 DEFINE_double(lost_grid_deg, 3.0,
               "calibrate: when lost, first an exhaustive rotation grid of +-this [deg] (0 = none)");
 DEFINE_double(lost_grid_step_deg, 0.5, "calibrate: step of that grid [deg]");
+DEFINE_bool(acquire_time_offset, true,
+            "calibrate: while acquiring, scan δ over its whole bound after the rotation grid");
 DEFINE_bool(bandpass_score, true,
             "calibrate: with --suppress_texture, score on the band-pass IDT (not clipped at 0)");
 // A band-pass score is near zero on average, so points just outside the image cost nothing:

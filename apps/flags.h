@@ -63,5 +63,6 @@ DECLARE_bool(search_from_last_healthy);
 DECLARE_bool(polish);
 DECLARE_double(lost_grid_deg);
 DECLARE_double(lost_grid_step_deg);
+DECLARE_bool(acquire_time_offset);
 DECLARE_bool(bandpass_score);
 DECLARE_double(point_margin);

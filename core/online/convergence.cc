@@ -91,6 +91,16 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
     }
     profile_problem = text;
   }
+  const TimeOffsetProfile& time_profile = verdict.time_offset_profile;
+  if (profile_problem.empty() && online.refine.estimate_time_offset &&
+      !time_profile.scores.empty() &&
+      std::abs(time_profile.best_s - verdict.estimate.time_offset_s) >
+          options.max_profile_offset_s) {
+    char text[160];
+    std::snprintf(text, sizeof(text), "the last frames' score over δ peaks %+.1f ms away",
+                  1000 * (time_profile.best_s - verdict.estimate.time_offset_s));
+    profile_problem = text;
+  }
 
   char text[256];
   if (used.empty()) {

@@ -26,6 +26,9 @@ struct ConvergenceOptions {
   // drives sit on the peak (offset 0); a street of poles, whose signs give a second alignment 3°
   // off, peaks 0.5° away on roll.
   double max_profile_offset_deg = 0.3;
+  // Likewise the score over δ (ProfileTimeOffset over the whole bound at the estimate's
+  // extrinsic, 2.5 ms steps) must peak within this of the estimate's δ [s].
+  double max_profile_offset_s = 0.01;
   // An independent check of the estimate on the texture-suppressed maps of the last
   // `check_frames` frames (windows of HealthCheckOptions::window_frames): foliage makes a plain
   // map's optimum degrees off look healthy, the suppressed maps do not (measured on KITTI: an

@@ -213,6 +213,16 @@ void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
             << " deg from the estimate over " << long_scorer->num_frames() << " frames";
     search_start = grid.state;
     search_options->first_level = scorer->num_levels() - 1;
+    // δ while acquiring: the whole bounded range at the grid's rotation. The local search moves δ
+    // a few steps at a time against its prior around δ0 and cannot cross tens of milliseconds;
+    // an aliased profile (a second peak nearly as high) leaves δ where it was.
+    if (was_acquiring && options_.acquire_time_offset && search_options->search_time_offset) {
+      const TimeOffsetProfile profile =
+          ProfileTimeOffset(long_scorer, search_start, search_options->time_offset_bound_s,
+                            search_options->time_offset_step_s);
+      if (!profile.alias_suspect) search_start.time_offset_s = profile.best_s;
+      grid_evaluations += static_cast<int>(profile.offsets_s.size());
+    }
   }
   if (was_acquiring && grid_agrees &&
       static_cast<int>(long_scorer->num_frames()) >= options_.refine_frames) {

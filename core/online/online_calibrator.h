@@ -42,6 +42,9 @@ struct OnlineCalibratorOptions {
   // each axis; √3 steps in all). A few
   // frames can have their global optimum far off; the frames a full window holds do not.
   bool acquire_with_grid = true;
+  // While acquiring, after the grid, δ is scanned over its whole bound at the grid's rotation and
+  // the search starts from the best δ (unless the profile has a second peak nearly as high).
+  bool acquire_time_offset = true;
   // When lost, also search from the last healthy estimate and offer the result as a candidate.
   bool search_from_last_healthy = true;
   // While tracking (not lost), an accepted update moves this share of the way to the new
