@@ -44,7 +44,8 @@ DEFINE_double(alpha4_translation_m, 0.01, "search: small translation step [m]");
 DEFINE_double(gamma, 0.45, "search: gray-rate threshold between the large and the small step pair");
 DEFINE_double(lost_health, 0.9, "calibrate: below this health the search goes coarse-to-fine");
 DEFINE_double(prior_sigma_rotation_deg, 2.0, "refine: weak rotation prior [deg]");
-DEFINE_double(prior_sigma_translation_m, 0.05, "search and refine: translation prior around the start [m]");
+DEFINE_double(prior_sigma_translation_m, 0.05,
+              "search and refine: translation prior around the start [m]");
 DEFINE_double(prior_sigma_forward_m, 0.05,
               "refine: translation prior along the direction of travel, per point [m]");
 DEFINE_double(prior_sigma_time_s, 0.03, "search and refine: time-offset prior around δ0 [s]");

@@ -217,9 +217,10 @@ std::string SimulateDrive(const std::string& out, const std::string& args) {
 constexpr char kShortDrive[] = " --refine_frames=10";
 RunResult CalibrateFromTwoDegrees(const std::string& drive, const std::string& out, int seed,
                                   const std::string& extra_flags = "") {
-  return RunStcalib("calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" +
-                    drive + " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=" +
-                    std::to_string(seed) + " --out=" + out + extra_flags);
+  return RunStcalib(
+      "calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" + drive +
+      " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=" + std::to_string(seed) +
+      " --out=" + out + extra_flags);
 }
 
 // Replaces line `index` (0-based) of a text file; `text` empty removes it.
@@ -336,9 +337,9 @@ TEST(Cli, CalibratesALargeTimeOffsetAndNeverClaimsAWrongOne) {
       nlohmann::json::parse(testing::ReadFile(tmp.path() + "/scan/result.json"));
   EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.006) << r.output;
   EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.3) << r.output;
-  EXPECT_LT(std::abs(result["time_offset_peak_s"].get<double>() -
-                     result["time_offset_s"].get<double>()),
-            0.005);
+  EXPECT_LT(
+      std::abs(result["time_offset_peak_s"].get<double>() - result["time_offset_s"].get<double>()),
+      0.005);
 
   const std::string out = tmp.path() + "/no_scan";
   const RunResult local = CalibrateFromTwoDegrees(
@@ -372,9 +373,8 @@ TEST(Cli, DegenerateScenesAreReportedNeverAWrongSuccess) {
       // deg over 20 frames) and sits near the default threshold (0.15 deg). With a threshold an
       // engineer might ask for, it is reported, held at its start value, and nothing is claimed.
       EXPECT_GT(result["std"]["roll_deg"].get<double>(), 0.1) << r.output;
-      const RunResult strict =
-          CalibrateFromTwoDegrees(drive, out + "_strict", 1,
-                                  std::string(kShortDrive) + " --observable_rotation_deg=0.1");
+      const RunResult strict = CalibrateFromTwoDegrees(
+          drive, out + "_strict", 1, std::string(kShortDrive) + " --observable_rotation_deg=0.1");
       EXPECT_EQ(strict.exit_code, 1) << strict.output;
       const nlohmann::json held =
           nlohmann::json::parse(testing::ReadFile(out + "_strict/result.json"));
