@@ -2,6 +2,7 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -220,8 +221,14 @@ void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
       const TimeOffsetProfile profile =
           ProfileTimeOffset(long_scorer, search_start, search_options->time_offset_bound_s,
                             search_options->time_offset_step_s);
-      if (!profile.alias_suspect) search_start.time_offset_s = profile.best_s;
-      grid_evaluations += static_cast<int>(profile.offsets_s.size());
+      const double floor = *std::min_element(profile.scores.begin(), profile.scores.end());
+      const double best = *std::max_element(profile.scores.begin(), profile.scores.end());
+      const double current = long_scorer->Evaluate(search_start, -1).score;
+      if (!profile.alias_suspect &&
+          current - floor < options_.acquire_time_offset_keep_ratio * (best - floor)) {
+        search_start.time_offset_s = profile.best_s;
+      }
+      grid_evaluations += static_cast<int>(profile.offsets_s.size()) + 1;
     }
   }
   if (was_acquiring && grid_agrees &&

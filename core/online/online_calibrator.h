@@ -45,6 +45,10 @@ struct OnlineCalibratorOptions {
   // While acquiring, after the grid, δ is scanned over its whole bound at the grid's rotation and
   // the search starts from the best δ (unless the profile has a second peak nearly as high).
   bool acquire_time_offset = true;
+  // The scan's δ is taken only when the estimate's δ scores less than this share of the way from
+  // the profile's lowest score to its best: where the two nearly tie, the local search decides
+  // (on KITTI the scan's best wanders by 5-10 ms while the rotation is still off).
+  double acquire_time_offset_keep_ratio = 0.9;
   // When lost, also search from the last healthy estimate and offer the result as a candidate.
   bool search_from_last_healthy = true;
   // While tracking (not lost), an accepted update moves this share of the way to the new
