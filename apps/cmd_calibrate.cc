@@ -142,6 +142,7 @@ CalibrateJob CalibrateJobFromFlags() {
   job.source.oriented_maps = FLAGS_oriented_maps;
   job.convergence.check_suppressed_health = FLAGS_check_suppressed_health;
   job.convergence.health_check.min_health = FLAGS_min_health;
+  job.convergence.min_final_health = FLAGS_lost_health;  // lost is never converged
   return job;
 }
 
