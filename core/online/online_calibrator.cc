@@ -217,10 +217,12 @@ void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
     // δ while acquiring: the whole bounded range at the grid's rotation. The local search moves δ
     // a few steps at a time against its prior around δ0 and cannot cross tens of milliseconds;
     // an aliased profile (a second peak nearly as high) leaves δ where it was.
-    if (was_acquiring && options_.acquire_time_offset && search_options->search_time_offset) {
-      const TimeOffsetProfile profile =
-          ProfileTimeOffset(long_scorer, search_start, search_options->time_offset_bound_s,
-                            search_options->time_offset_step_s);
+    const TimeOffsetProfile profile =
+        was_acquiring && options_.acquire_time_offset && search_options->search_time_offset
+            ? ProfileTimeOffset(long_scorer, search_start, search_options->time_offset_bound_s,
+                                search_options->time_offset_step_s)
+            : TimeOffsetProfile();
+    if (!profile.scores.empty()) {
       const double floor = *std::min_element(profile.scores.begin(), profile.scores.end());
       const double best = *std::max_element(profile.scores.begin(), profile.scores.end());
       const double current = long_scorer->Evaluate(search_start, -1).score;
