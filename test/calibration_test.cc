@@ -102,7 +102,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   EXPECT_GT(health_truth, 0.9);
   EXPECT_LT(health_off, health_truth - 0.2);
 
-  // Search: coarse-to-fine from 2° on every axis comes back within 1°.
+  // Search: coarse-to-fine from 2° on every axis comes back within 0.5° (measured 0.20°).
   const CalibrationState start =
       Step(truth, Eigen::Vector3d(2, -2, 2) * M_PI / 180.0, Eigen::Vector3d::Zero(), -0.03);
   const SearchResult search =
@@ -111,7 +111,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   std::printf("search from %.2f deg: %s (%d evaluations)\n",
               ComputeCalibrationError(start, truth).rotation_deg, ToString(search_error).c_str(),
               search.evaluations);
-  EXPECT_LT(search_error.rotation_deg, 1.0);
+  EXPECT_LT(search_error.rotation_deg, 0.5);
   EXPECT_GT(search.end.score, search.start.score);
 
   // Rotation grid (±3° at 0.5°) around a start 3.5° off: its best point is within about a grid
@@ -126,7 +126,8 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
               ComputeCalibrationError(start_true_delta, truth).rotation_deg,
               ToString(grid_error).c_str());
   EXPECT_EQ(grid.evaluations, 13 * 13 * 13);
-  // Measured: 0.77° (roll +0.70, the weak axis of this window; pitch −0.29, yaw +0.11).
+  // Measured on the default (band-pass) score maps: 0.37° (roll −0.31, the weak axis of this
+  // window; pitch +0.19, yaw +0.10); 0.77° on the plain IDT.
   EXPECT_LT(grid_error.rotation_deg, 1.0);
   EXPECT_LT(std::abs(grid_error.roll_deg), 0.75);
   EXPECT_LT(std::abs(grid_error.pitch_deg), 0.5);
@@ -144,7 +145,8 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   std::printf("refine from %.3f deg: %s; std roll %.3f deg, time %.4f s, corr(δ, forward) %.2f\n",
               ComputeCalibrationError(near, truth).rotation_deg, ToString(refine_error).c_str(),
               refine.std_dev[0], refine.std_dev[6], refine.time_forward_correlation);
-  // Measured: 0.58° (a roll bias of the vertical edges on this drive, see the issue note).
+  // Measured: 0.41° (roll +0.41, a roll bias of the vertical edges on this drive; 0.58° on the
+  // plain IDT).
   EXPECT_LT(refine_error.rotation_deg, 1.0);
   EXPECT_TRUE(refine.covariance_ok);
   EXPECT_LT(std::abs(refine_error.time_offset_s), 0.02);
@@ -155,16 +157,19 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
               profile.best_s, profile.second_peak_ratio);
   EXPECT_NEAR(profile.best_s, 0.03, 0.015);
 
-  // The online calibrator over the drive from ±2° / ±5 cm / δ0 = 0.
-  OnlineCalibrator calibrator(OnlineCalibratorOptions(),
+  // The online calibrator over the drive from ±2° / ±5 cm / δ0 = 0, with the defaults but for
+  // the refinement window: the acquisition ends only when the grid agrees with the estimate on a
+  // full refinement window, which needs a drive longer than these 12 frames at the default 20.
+  OnlineCalibratorOptions online_options;
+  online_options.refine_frames = 10;
+  OnlineCalibrator calibrator(online_options,
                               Step(truth, Eigen::Vector3d(-2, 2, -2) * M_PI / 180.0,
                                    Eigen::Vector3d(0.05, -0.05, 0.05), -0.03));
   FrameReport last;
-  const OnlineCalibratorOptions defaults;
   for (size_t k = 0; k < frames.size(); ++k) {
     const CalibrationState before = calibrator.state();
     last = calibrator.AddFrame(frames[k]);
-    if (static_cast<int>(k) + 1 < defaults.window_frames) {
+    if (static_cast<int>(k) + 1 < online_options.window_frames) {
       // One or two frames are not trusted with a jump: the window fills first.
       EXPECT_FALSE(last.accepted);
       EXPECT_NE(last.reason.find("window filling"), std::string::npos) << last.reason;
@@ -174,7 +179,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   const CalibrationError online_error = ComputeCalibrationError(calibrator.state(), truth);
   std::printf("online after %zu frames: %s, health %.2f\n", frames.size(),
               ToString(online_error).c_str(), last.health);
-  EXPECT_LT(online_error.rotation_deg, 1.0);  // measured 0.45° (from 3.46°)
+  EXPECT_LT(online_error.rotation_deg, 0.5);  // measured 0.22° (from 3.46°; plain IDT 0.45°)
   EXPECT_LT(online_error.translation_norm_m, 0.12);
   EXPECT_LT(std::abs(online_error.time_offset_s), 0.02);
   EXPECT_GT(last.health, 0.8);
@@ -190,14 +195,20 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     again->camera_time_s += 10.0;
     const FrameReport r = calibrator.AddFrame(again);
     reasons.push_back(r.reason);
-    std::printf("after the disturbance, frame %zu: %.3f deg from the settled estimate (%s)\n", k,
+    std::printf("after the disturbance, frame %zu: %.3f deg from the settled estimate, %.3f deg "
+                "from the truth (%s)\n",
+                k,
                 RotationErrorDeg(calibrator.state().T_camera_lidar.linear(),
                                  settled.T_camera_lidar.linear()),
-                r.reason.c_str());
+                ComputeCalibrationError(calibrator.state(), truth).rotation_deg, r.reason.c_str());
   }
+  // Back from 3.5° to the refinement's optimum on these frames (measured 0.53° from the truth,
+  // 0.33° from the settled estimate; the polish below lands at 0.51°, a roll bias of this short
+  // drive): the settled estimate is a filtered one (tracking gain) that had not reached it.
+  EXPECT_LT(ComputeCalibrationError(calibrator.state(), truth).rotation_deg, 0.6);
   EXPECT_LT(
       RotationErrorDeg(calibrator.state().T_camera_lidar.linear(), settled.T_camera_lidar.linear()),
-      0.3);
+      0.4);
 
   // Polish: a rotation-only refinement over the refinement's frames from the estimate. From two
   // estimates 0.6° apart it lands on one optimum (the online estimate is a filtered one; the
@@ -227,9 +238,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
       RotationErrorDeg(polished[0].T_camera_lidar.linear(), polished[1].T_camera_lidar.linear()),
       0.1);
   // While acquiring (a grid that has not yet agreed) there is nothing to polish.
-  OnlineCalibratorOptions acquiring_options;
-  acquiring_options.lost_grid_deg = 3.0;
-  OnlineCalibrator acquiring(acquiring_options, truth);
+  OnlineCalibrator acquiring(OnlineCalibratorOptions(), truth);  // the default ±3° grid
   const FrameReport not_yet = acquiring.Polish();
   EXPECT_FALSE(not_yet.accepted);
   EXPECT_NE(not_yet.reason.find("no frames"), std::string::npos) << not_yet.reason;

@@ -15,11 +15,13 @@ struct FrameSourceOptions {
   ImageFeatureOptions image;
   LidarFeatureOptions lidar;
   LocalMapOptions local_map;
-  bool suppress_texture = false;  ///< score maps are the texture-suppressed IDTs
+  // Dense foliage traps the plain IDT score degrees from the truth (method.md §10): score on
+  // texture-suppressed maps.
+  bool suppress_texture = true;  ///< score maps are the texture-suppressed IDTs
   // With suppress_texture: the finest score map is the band-pass IDT (not clipped at zero, see
-  // BandPass) rather than the clipped one. The health check keeps the clipped maps its
-  // thresholds were measured on.
-  bool bandpass_score = false;
+  // BandPass: foliage averages to zero instead of pulling points into it) rather than the clipped
+  // one. The health check keeps the clipped maps its thresholds were measured on.
+  bool bandpass_score = true;
   bool oriented_maps = true;  ///< vertical/horizontal LiDAR edges read their own maps
   // A frame whose image time lies in a longer gap between oxts packets (or further from the
   // nearest one) is refused: its motion model would be a guess [s].

@@ -30,6 +30,11 @@ CalibrationState KeepObservableAxes(const CalibrationState& old, const Calibrati
   return Step(old, r, t, observable[6] ? candidate.time_offset_s - old.time_offset_s : 0.0);
 }
 
+OnlineCalibratorOptions::OnlineCalibratorOptions() {
+  score.horizontal_weight = 0.2;
+  refine.horizontal_weight = 0.2;
+}
+
 Status OnlineCalibratorOptions::Validate() const {
   if (window_frames < 1) return Status::Error("online: window_frames must be >= 1");
   STCALIB_RETURN_IF_ERROR(search.Validate());
