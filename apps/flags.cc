@@ -111,8 +111,7 @@ DEFINE_bool(polish, true,
             "calibrate: refine the final estimate over the refinement's frames from itself");
 DEFINE_double(lost_grid_deg, kOnline.lost_grid_deg,
               "calibrate: when lost, first an exhaustive rotation grid of +-this [deg] (0 = none)");
-DEFINE_double(lost_grid_step_deg, kOnline.lost_grid_step_deg,
-              "calibrate: step of that grid [deg]");
+DEFINE_double(lost_grid_step_deg, kOnline.lost_grid_step_deg, "calibrate: step of that grid [deg]");
 DEFINE_bool(acquire_time_offset, kOnline.acquire_time_offset,
             "calibrate: while acquiring, scan δ over its whole bound after the rotation grid");
 DEFINE_bool(bandpass_score, kSource.bandpass_score,

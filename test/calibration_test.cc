@@ -162,9 +162,8 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   // full refinement window, which needs a drive longer than these 12 frames at the default 20.
   OnlineCalibratorOptions online_options;
   online_options.refine_frames = 10;
-  OnlineCalibrator calibrator(online_options,
-                              Step(truth, Eigen::Vector3d(-2, 2, -2) * M_PI / 180.0,
-                                   Eigen::Vector3d(0.05, -0.05, 0.05), -0.03));
+  OnlineCalibrator calibrator(online_options, Step(truth, Eigen::Vector3d(-2, 2, -2) * M_PI / 180.0,
+                                                   Eigen::Vector3d(0.05, -0.05, 0.05), -0.03));
   FrameReport last;
   for (size_t k = 0; k < frames.size(); ++k) {
     const CalibrationState before = calibrator.state();
@@ -195,12 +194,13 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     again->camera_time_s += 10.0;
     const FrameReport r = calibrator.AddFrame(again);
     reasons.push_back(r.reason);
-    std::printf("after the disturbance, frame %zu: %.3f deg from the settled estimate, %.3f deg "
-                "from the truth (%s)\n",
-                k,
-                RotationErrorDeg(calibrator.state().T_camera_lidar.linear(),
-                                 settled.T_camera_lidar.linear()),
-                ComputeCalibrationError(calibrator.state(), truth).rotation_deg, r.reason.c_str());
+    std::printf(
+        "after the disturbance, frame %zu: %.3f deg from the settled estimate, %.3f deg "
+        "from the truth (%s)\n",
+        k,
+        RotationErrorDeg(calibrator.state().T_camera_lidar.linear(),
+                         settled.T_camera_lidar.linear()),
+        ComputeCalibrationError(calibrator.state(), truth).rotation_deg, r.reason.c_str());
   }
   // Back from 3.5° to the refinement's optimum on these frames (measured 0.53° from the truth,
   // 0.33° from the settled estimate; the polish below lands at 0.51°, a roll bias of this short
