@@ -44,11 +44,11 @@ cv::Mat PlotPanel(const std::string& title, const std::vector<double>& x,
     }
   }
   if (y_max - y_min < 1e-9) y_max = y_min + 1;
-  // Round ticks, the range (with a little room, so no line runs along the frame) widened to
-  // whole steps.
+  // Round ticks, the range (with a little room, so no line runs along the frame; none below a
+  // series that never goes negative) widened to whole steps.
   const double pad = 0.02 * (y_max - y_min);
-  y_min -= pad;
-  y_max += pad;
+  if (y_min < 0) y_min -= pad;
+  if (y_max > 0) y_max += pad;
   const double y_step = NiceTickStep(y_min, y_max, 6);
   y_min = std::floor(y_min / y_step) * y_step;
   y_max = std::ceil(y_max / y_step) * y_step;
