@@ -86,6 +86,39 @@ void BM_RotationGrid(benchmark::State& state) {
 }
 BENCHMARK(BM_RotationGrid)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
 
+// The health score (method.md §7): 728 neighbours of the estimate scored over N frames; an
+// online update measures it before and after, and every 6-DoF search step scores as many.
+void BM_HealthScore(benchmark::State& state) {
+  if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
+  CalibrationState initial;
+  initial.T_camera_lidar = Kitti().drive.T_camera_lidar;
+  std::vector<const CalibrationFrame*> frames;
+  for (int i = 0; i < state.range(0); ++i) frames.push_back(Kitti().frames[i].get());
+  WindowScorer scorer(frames, ScoreOptions());
+  for (auto _ : state) benchmark::DoNotOptimize(HealthScore(&scorer, initial));
+  state.SetLabel("728 neighbours over " + std::to_string(state.range(0)) + " frames");
+}
+BENCHMARK(BM_HealthScore)->Arg(3)->Unit(benchmark::kMillisecond);
+
+// The joint refinement (Ceres, rotation + translation + δ, with the covariance) over N frames
+// from the estimate, as while tracking.
+void BM_Refine(benchmark::State& state) {
+  if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
+  CalibrationState initial;
+  initial.T_camera_lidar = Kitti().drive.T_camera_lidar;
+  std::vector<const CalibrationFrame*> frames;
+  for (int i = 0; i < state.range(0); ++i) frames.push_back(Kitti().frames[i].get());
+  const RefineOptions options = OnlineCalibratorOptions().refine;
+  int iterations = 0;
+  for (auto _ : state) {
+    const RefineResult r = Refine(frames, initial, initial, initial, options);
+    iterations = r.iterations;
+  }
+  state.SetLabel(std::to_string(state.range(0)) + " frames, " + std::to_string(iterations) +
+                 " iterations");
+}
+BENCHMARK(BM_Refine)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
+
 // Image features, LiDAR features and local map for one new frame (sweeps before it cached).
 void BM_FrameFeatures(benchmark::State& state) {
   if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
