@@ -324,6 +324,24 @@ TEST(Cli, CalibratesADriveWithoutOxtsFromScanRegistration) {
   EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.01) << r.output;
 }
 
+// The paper's disturbance protocol at the very end of a drive: the 3.5° disturbance two frames
+// before the end is pulled back within its frame, but the frames after it are too few to show
+// that the estimate settled there, so nothing is claimed (a jump that late could as well land on
+// a side peak the last frames merely keep).
+TEST(Cli, RunEndingRightAfterADisturbanceClaimsNothing) {
+  testing::ScopedTempDir tmp;
+  const std::string drive = SimulateDrive(tmp.path(), "--frames=12 --seed=3 --time_offset_s=0.03");
+  ASSERT_FALSE(drive.empty());
+  const std::string out = tmp.path() + "/out";
+  const RunResult r =
+      CalibrateFromTwoDegrees(drive, out, 3, std::string(kShortDrive) + " --disturb_frame=10");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("not converged: still moving"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/calib_velo_to_cam.txt"));
+  const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
+  EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.5) << r.output;  // measured 0.18°
+}
+
 // A time offset of −100 ms from a start of δ0 = 0: the local search alone moves δ a few steps at
 // a time against its prior and settles on a wrong peak; the δ scan while acquiring finds it. A
 // run without that scan must not claim success (the score over δ peaks far from its δ).

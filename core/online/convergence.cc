@@ -47,14 +47,19 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   verdict.skipped_frames = static_cast<int>(reports.size() - used.size());
   const FrameReport empty_report;
   const FrameReport& last = used.empty() ? empty_report : *used.back();
+  // The online trajectory's own moves over the last settle_frames frames (a final polish is not a
+  // frame): every estimate those frames started from or ended at lies within max_settle_deg of
+  // the last. A jump in the first of them lands on a state the later frames merely keep (a KITTI
+  // run jumped 3° to a side peak two frames before its end).
   double settle_deg = 0;
   for (size_t k = used.size() >= static_cast<size_t>(options.settle_frames)
                       ? used.size() - options.settle_frames
                       : 0;
        k < used.size(); ++k) {
-    // The online trajectory's own moves (a final polish is not a frame).
-    settle_deg = std::max(settle_deg, RotationErrorDeg(used[k]->after.T_camera_lidar.linear(),
-                                                       last.after.T_camera_lidar.linear()));
+    for (const CalibrationState* state : {&used[k]->before, &used[k]->after}) {
+      settle_deg = std::max(settle_deg, RotationErrorDeg(state->T_camera_lidar.linear(),
+                                                         last.after.T_camera_lidar.linear()));
+    }
   }
 
   // Axes the last refinement could not pin down were held: they go back to the start (earlier

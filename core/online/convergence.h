@@ -13,10 +13,12 @@ namespace stcalib {
 // When may a run of the online calibrator claim a calibration? Every rule below has caught a
 // wrong claim on some drive; the verdict is the first rule that fails.
 struct ConvergenceOptions {
-  int min_points = 30;                     ///< LiDAR edge points in the last window
-  int min_frames = 3;                      ///< used frames needed to see the estimate settle
-  int settle_frames = 3;                   ///< the estimate's last moves are judged over these
-  double max_settle_deg = 0.3;             ///< largest rotation move over settle_frames [deg]
+  int min_points = 30;    ///< LiDAR edge points in the last window
+  int min_frames = 3;     ///< used frames needed to see the estimate settle
+  int settle_frames = 3;  ///< the estimate's last moves are judged over these
+  // Every estimate the last settle_frames frames started from or ended at lies this close to the
+  // final one [deg].
+  double max_settle_deg = 0.3;
   // Health of the last window at the estimate: at least the calibrator's own lost_health (an
   // estimate it would search away from is not converged). Measured: converged runs end at
   // 0.955-1.0 (KITTI, 16 starts; simulated, 14 seeds); a KITTI run that ended on a side peak 3.95°
