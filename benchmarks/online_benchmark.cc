@@ -119,6 +119,46 @@ void BM_Refine(benchmark::State& state) {
 }
 BENCHMARK(BM_Refine)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
 
+// The whole per-frame path with the defaults (20-frame refinement): image and LiDAR features
+// with the local map, then the online update, for each new frame of the drive while tracking.
+// The calibrator first runs through frames 0-21 (its acquisition ends within them); frames 22-29
+// then cycle, restamped so that they keep arriving in time order.
+void BM_WholeFrame(benchmark::State& state) {
+  if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
+  constexpr size_t kFirstTimed = 22;
+  if (Kitti().drive.NumFrames() <= kFirstTimed) return state.SkipWithError("too few frames");
+  CalibrationState initial;
+  initial.T_camera_lidar = Kitti().drive.T_camera_lidar;
+  std::unique_ptr<DriveFrameSource> source;
+  if (!DriveFrameSource::Create(&Kitti().drive, FrameSourceOptions(), &source).ok()) {
+    return state.SkipWithError("frame source");
+  }
+  OnlineCalibrator calibrator(OnlineCalibratorOptions(), initial);
+  double camera_time_s = 0;
+  for (size_t i = 0; i < kFirstTimed; ++i) {
+    auto frame = std::make_shared<CalibrationFrame>();
+    if (!source->Load(i, frame.get()).ok()) return state.SkipWithError("load");
+    camera_time_s = frame->camera_time_s;
+    calibrator.AddFrame(frame);
+  }
+  size_t next = kFirstTimed;
+  int coarse = 0;
+  for (auto _ : state) {
+    auto frame = std::make_shared<CalibrationFrame>();
+    if (!source->Load(next, frame.get()).ok()) return state.SkipWithError("load");
+    camera_time_s += 0.1;
+    frame->camera_time_s = camera_time_s;
+    const FrameReport report = calibrator.AddFrame(frame);
+    if (report.skipped) return state.SkipWithError(report.reason.c_str());
+    coarse += report.coarse_search;
+    next = next + 1 < Kitti().drive.NumFrames() ? next + 1 : kFirstTimed;
+  }
+  state.SetLabel(
+      "features + update, refine over 20 frames" +
+      (coarse > 0 ? ", " + std::to_string(coarse) + " coarse (acquiring or lost)" : std::string()));
+}
+BENCHMARK(BM_WholeFrame)->Unit(benchmark::kMillisecond);
+
 // Image features, LiDAR features and local map for one new frame (sweeps before it cached).
 void BM_FrameFeatures(benchmark::State& state) {
   if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
