@@ -38,10 +38,23 @@ Fixture& Kitti() {
   return *fixture;
 }
 
+// KITTI's own calibration, δ = 0.
+CalibrationState KittiCalibration() {
+  CalibrationState calibration;
+  calibration.T_camera_lidar = Kitti().drive.T_camera_lidar;
+  return calibration;
+}
+
+// The first n loaded frames.
+std::vector<const CalibrationFrame*> FirstFrames(int64_t n) {
+  std::vector<const CalibrationFrame*> frames;
+  for (int64_t i = 0; i < n; ++i) frames.push_back(Kitti().frames[i].get());
+  return frames;
+}
+
 void BM_OnlineUpdate(benchmark::State& state) {
   if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
-  CalibrationState initial;
-  initial.T_camera_lidar = Kitti().drive.T_camera_lidar;
+  const CalibrationState initial = KittiCalibration();
   OnlineCalibratorOptions options;
   options.refine_frames = static_cast<int>(state.range(0));
   OnlineCalibrator calibrator(options, initial);
@@ -73,10 +86,8 @@ BENCHMARK(BM_OnlineUpdate)->Arg(3)->Arg(10)->Unit(benchmark::kMillisecond);
 // on every frame while acquiring and when lost, not while tracking.
 void BM_RotationGrid(benchmark::State& state) {
   if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
-  CalibrationState initial;
-  initial.T_camera_lidar = Kitti().drive.T_camera_lidar;
-  std::vector<const CalibrationFrame*> frames;
-  for (int i = 0; i < state.range(0); ++i) frames.push_back(Kitti().frames[i].get());
+  const CalibrationState initial = KittiCalibration();
+  const std::vector<const CalibrationFrame*> frames = FirstFrames(state.range(0));
   WindowScorer scorer(frames, ScoreOptions());
   for (auto _ : state) {
     benchmark::DoNotOptimize(
@@ -90,10 +101,8 @@ BENCHMARK(BM_RotationGrid)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
 // online update measures it before and after, and every 6-DoF search step scores as many.
 void BM_HealthScore(benchmark::State& state) {
   if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
-  CalibrationState initial;
-  initial.T_camera_lidar = Kitti().drive.T_camera_lidar;
-  std::vector<const CalibrationFrame*> frames;
-  for (int i = 0; i < state.range(0); ++i) frames.push_back(Kitti().frames[i].get());
+  const CalibrationState initial = KittiCalibration();
+  const std::vector<const CalibrationFrame*> frames = FirstFrames(state.range(0));
   WindowScorer scorer(frames, ScoreOptions());
   for (auto _ : state) benchmark::DoNotOptimize(HealthScore(&scorer, initial));
   state.SetLabel("728 neighbours over " + std::to_string(state.range(0)) + " frames");
@@ -104,10 +113,8 @@ BENCHMARK(BM_HealthScore)->Arg(3)->Unit(benchmark::kMillisecond);
 // from the estimate, as while tracking.
 void BM_Refine(benchmark::State& state) {
   if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
-  CalibrationState initial;
-  initial.T_camera_lidar = Kitti().drive.T_camera_lidar;
-  std::vector<const CalibrationFrame*> frames;
-  for (int i = 0; i < state.range(0); ++i) frames.push_back(Kitti().frames[i].get());
+  const CalibrationState initial = KittiCalibration();
+  const std::vector<const CalibrationFrame*> frames = FirstFrames(state.range(0));
   const RefineOptions options = OnlineCalibratorOptions().refine;
   int iterations = 0;
   for (auto _ : state) {
@@ -127,8 +134,7 @@ void BM_WholeFrame(benchmark::State& state) {
   if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
   constexpr size_t kFirstTimed = 22;
   if (Kitti().drive.NumFrames() <= kFirstTimed) return state.SkipWithError("too few frames");
-  CalibrationState initial;
-  initial.T_camera_lidar = Kitti().drive.T_camera_lidar;
+  const CalibrationState initial = KittiCalibration();
   std::unique_ptr<DriveFrameSource> source;
   if (!DriveFrameSource::Create(&Kitti().drive, FrameSourceOptions(), &source).ok()) {
     return state.SkipWithError("frame source");
