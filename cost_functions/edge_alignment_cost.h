@@ -1,10 +1,12 @@
 #pragma once
 
-#include <ceres/autodiff_cost_function.h>
 #include <ceres/cubic_interpolation.h>
+#include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 
 #include "core/motion/motion_model.h"
 #include "core/types/camera_model.h"
@@ -22,12 +24,28 @@ using DistanceInterpolator = ceres::BiCubicInterpolator<DistanceGrid>;
 // LiDAR's own motion and then into the camera:
 //
 //   e        = (t_l + δ) − t_c = e0 + δ                       (method.md §2)
-//   p_c      = R · Tv(e) · p + t,   Tv(e) = Exp(e · ξ_L)       (ξ_L: LiDAR body twist, §3)
-//   (u, v)   = π(P_rect_02 · [R_rect_00 · p_c; 1])
+//   p_m      = Tv(e) · p,       Tv(e) = Exp(e · ξ_L)           (ξ_L = (ω, v): LiDAR body twist, §3)
+//   p_c      = R · p_m + t,     R = R(q / |q|)
+//   h        = P · R_rect · p_c + p4,   (u, v) = (h_x / h_z, h_y / h_z)
 //   r        = √w · D(v, u)
 //
-// with D the smoothed distance map read by a bicubic interpolator and w the point's weight
-// (horizontal and vertical edges weighted w and 1 − w). The residual is in pixels.
+// with D the smoothed distance map read by a bicubic interpolator, P | p4 = P_rect_02 and w the
+// point's weight (horizontal and vertical edges weighted w and 1 − w). The residual is in pixels.
+//
+// Jacobians (analytic; autodiff through the motion model's sines and the quaternion cost about
+// 5x more per residual, and the residuals are most of a refinement's time). With
+// g = √w · [∂D/∂u, ∂D/∂v] and A = ∂(u, v)/∂h · P · R_rect, ∂(u, v)/∂h = [1/h_z, 0, −h_x/h_z²;
+// 0, 1/h_z, −h_y/h_z²], the row J = g · A = ∂r/∂p_c, and
+//   ∂r/∂t = J;
+//   ∂r/∂δ = J · R · (ω × p_m + v)      (d/de Exp(eξ)·p = ξ^ · Exp(eξ)·p: a constant twist
+//                                        commutes with its own exponential);
+//   ∂r/∂θ = −2 · J · [R·p_m]×          (tangent θ of EigenQuaternionManifold: q ⊕ θ =
+//                                        [cos|θ|, sin|θ|·θ/|θ|] ⊗ q rotates by 2θ on the camera
+//                                        side, so p_c moves by 2θ × R·p_m);
+//   ∂r/∂q = ∂r/∂θ · Mᵀ / |q|           (ambient, with M = ∂(q ⊕ θ)/∂θ at θ = 0 for the unit q̂:
+//                                        Mᵀ = [q̂_w·I + [q̂_v]× | −q̂_v]; M has orthonormal columns
+//                                        orthogonal to q̂, so this is the exact gradient of the
+//                                        normalised function and Ceres' M·(·) gives ∂r/∂θ back).
 //
 // Parameters: the extrinsic T_camera_lidar as one block [qx, qy, qz, qw, tx, ty, tz] (Eigen
 // quaternion order, on ProductManifold<EigenQuaternionManifold, EuclideanManifold<3>>) and the
@@ -35,7 +53,7 @@ using DistanceInterpolator = ceres::BiCubicInterpolator<DistanceGrid>;
 // costs the constant `outside_px` (the map's cap) with zero derivative: it is dropped for that
 // evaluation rather than clamped to the border, and leaving the image is never a way to lower
 // the cost.
-class EdgeAlignmentCost {
+class EdgeAlignmentCost : public ceres::SizedCostFunction<1, 7, 1> {
  public:
   EdgeAlignmentCost(const Eigen::Vector3d& point_lidar, double weight, const LidarTwist& twist,
                     double e0_s, const CameraModel* camera, const DistanceInterpolator* map,
@@ -48,23 +66,46 @@ class EdgeAlignmentCost {
         map_(map),
         outside_px_(outside_px) {}
 
-  template <typename T>
-  bool operator()(const T* const pose, const T* const time_offset, T* residual) const {
-    // Normalised so that the residual depends on the rotation only, not on |q|.
-    const Eigen::Quaternion<T> q = Eigen::Map<const Eigen::Quaternion<T>>(pose).normalized();
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t(pose + 4);
-    const T e = T(e0_s_) + time_offset[0];
-    const Eigen::Matrix<T, 3, 1> p_moved = ApplyLidarMotion<T>(twist_, e, point_lidar_.cast<T>());
-    const Eigen::Matrix<T, 3, 1> p_camera = q * p_moved + t;
-    Eigen::Matrix<T, 2, 1> pixel;
-    T depth;
-    if (!camera_->Project<T>(p_camera, &pixel, &depth) || !Inside(pixel)) {
-      residual[0] = T(sqrt_weight_ * outside_px_);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* pose = parameters[0];
+    const Eigen::Map<const Eigen::Vector4d> q_coeffs(pose);
+    const double q_norm = q_coeffs.norm();
+    const Eigen::Quaterniond q(q_coeffs / q_norm);  // unit: the residual ignores |q|
+    const Eigen::Map<const Eigen::Vector3d> t(pose + 4);
+    const double e = e0_s_ + parameters[1][0];
+    const Eigen::Vector3d p_moved = ApplyLidarMotion<double>(twist_, e, point_lidar_);
+    const Eigen::Vector3d p_rotated = q * p_moved;
+    Eigen::Vector2d pixel;
+    Eigen::Matrix<double, 2, 3> d_pixel_d_point;
+    if (!camera_->ProjectWithJacobian(p_rotated + t, &pixel, &d_pixel_d_point) || !Inside(pixel)) {
+      residuals[0] = sqrt_weight_ * outside_px_;
+      if (jacobians != nullptr) {
+        if (jacobians[0] != nullptr) std::fill(jacobians[0], jacobians[0] + 7, 0.0);
+        if (jacobians[1] != nullptr) jacobians[1][0] = 0.0;
+      }
       return true;
     }
-    T value;
-    map_->Evaluate(pixel.y(), pixel.x(), &value);
-    residual[0] = T(sqrt_weight_) * value;
+    double value, d_dv, d_du;
+    map_->Evaluate(pixel.y(), pixel.x(), &value, &d_dv, &d_du);
+    residuals[0] = sqrt_weight_ * value;
+    if (jacobians == nullptr) return true;
+    const Eigen::RowVector3d d_point =
+        sqrt_weight_ * Eigen::RowVector2d(d_du, d_dv) * d_pixel_d_point;
+    if (jacobians[0] != nullptr) {
+      const Eigen::RowVector3d d_theta = 2.0 * p_rotated.cross(d_point.transpose()).transpose();
+      Eigen::Matrix<double, 3, 4> m_transpose;
+      m_transpose.leftCols<3>() << q.w(), -q.z(), q.y(),  //
+          q.z(), q.w(), -q.x(),                           //
+          -q.y(), q.x(), q.w();
+      m_transpose.col(3) = -q.vec();
+      Eigen::Map<Eigen::Matrix<double, 1, 7>> j_pose(jacobians[0]);
+      j_pose.head<4>() = d_theta * m_transpose / q_norm;
+      j_pose.tail<3>() = d_point;
+    }
+    if (jacobians[1] != nullptr) {
+      jacobians[1][0] = d_point.dot(q * (twist_.angular_rad_s.cross(p_moved) + twist_.linear_m_s));
+    }
     return true;
   }
 
@@ -72,16 +113,14 @@ class EdgeAlignmentCost {
                                      const LidarTwist& twist, double e0_s,
                                      const CameraModel* camera, const DistanceInterpolator* map,
                                      double outside_px) {
-    return new ceres::AutoDiffCostFunction<EdgeAlignmentCost, 1, 7, 1>(
-        new EdgeAlignmentCost(point_lidar, weight, twist, e0_s, camera, map, outside_px));
+    return new EdgeAlignmentCost(point_lidar, weight, twist, e0_s, camera, map, outside_px);
   }
 
  private:
-  template <typename T>
-  bool Inside(const Eigen::Matrix<T, 2, 1>& pixel) const {
+  bool Inside(const Eigen::Vector2d& pixel) const {
     // One pixel of margin keeps the bicubic stencil on real data.
-    return pixel.x() >= T(1) && pixel.y() >= T(1) && pixel.x() <= T(camera_->width - 2) &&
-           pixel.y() <= T(camera_->height - 2);
+    return pixel.x() >= 1 && pixel.y() >= 1 && pixel.x() <= camera_->width - 2 &&
+           pixel.y() <= camera_->height - 2;
   }
 
   const Eigen::Vector3d point_lidar_;

@@ -29,6 +29,23 @@ struct CameraModel {
     return true;
   }
 
+  // Project() for doubles, with the Jacobian of the pixel with respect to p_camera:
+  //   h = P·R_rect·p + p4, (u, v) = (h_x/h_z, h_y/h_z),
+  //   ∂(u, v)/∂p = [1/h_z, 0, −h_x/h_z²; 0, 1/h_z, −h_y/h_z²] · P · R_rect.
+  bool ProjectWithJacobian(const Eigen::Vector3d& p_camera, Eigen::Vector2d* pixel,
+                           Eigen::Matrix<double, 2, 3>* d_pixel_d_point) const {
+    const Eigen::Vector3d p_rect = R_rect_00 * p_camera;
+    if (p_rect.z() < min_depth_m) return false;
+    const Eigen::Vector3d h = P_rect_02.leftCols<3>() * p_rect + P_rect_02.col(3);
+    if (h.z() <= 0) return false;
+    const double inv_z = 1.0 / h.z();
+    (*pixel) << h.x() * inv_z, h.y() * inv_z;
+    Eigen::Matrix<double, 2, 3> d_pixel_d_h;
+    d_pixel_d_h << inv_z, 0, -(*pixel)(0) * inv_z, 0, inv_z, -(*pixel)(1) * inv_z;
+    *d_pixel_d_point = d_pixel_d_h * P_rect_02.leftCols<3>() * R_rect_00;
+    return true;
+  }
+
   bool InImage(const Eigen::Vector2d& pixel) const {
     return pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() <= width - 1.0 &&
            pixel.y() <= height - 1.0;
