@@ -110,7 +110,7 @@ CalibrateJob CalibrateJobFromFlags() {
   o.lost_grid_step_deg = FLAGS_lost_grid_step_deg;
   o.acquire_time_offset = FLAGS_acquire_time_offset;
   o.point_margin = FLAGS_point_margin;
-  o.score.horizontal_weight = FLAGS_horizontal_weight;
+  o.horizontal_weight = FLAGS_horizontal_weight;
   o.search.alpha1_rotation_deg = FLAGS_alpha1_rotation_deg;
   o.search.alpha2_translation_m = FLAGS_alpha2_translation_m;
   o.search.alpha3_rotation_deg = FLAGS_alpha3_rotation_deg;
@@ -123,7 +123,6 @@ CalibrateJob CalibrateJobFromFlags() {
   o.refine.loss =
       FLAGS_loss == "huber" ? RefineOptions::Loss::kHuber : RefineOptions::Loss::kCauchy;
   o.refine.loss_scale_px = FLAGS_loss_scale_px;
-  o.refine.horizontal_weight = FLAGS_horizontal_weight;
   o.refine.prior_sigma_rotation_deg = FLAGS_prior_sigma_rotation_deg;
   o.refine.prior_sigma_translation_m = FLAGS_prior_sigma_translation_m;
   o.refine.prior_sigma_forward_m = FLAGS_prior_sigma_forward_m;

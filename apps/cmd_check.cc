@@ -44,7 +44,6 @@ int RunCheck() {
   // plain map's health flat (a calibration 1° off still scores near its neighbours).
   FrameSourceOptions source_options;
   source_options.suppress_texture = true;
-  source_options.bandpass_score = false;  // the clipped maps the check's thresholds were set on
   source_options.local_map.sweeps = FLAGS_local_map_sweeps;
   std::unique_ptr<DriveFrameSource> source;
   status = DriveFrameSource::Create(&drive, source_options, &source);

@@ -44,7 +44,7 @@ DEFINE_bool(estimate_time_offset, kOnline.refine.estimate_time_offset,
 DEFINE_string(loss, "cauchy", "calibrate: robust loss, cauchy | huber");
 // Refinement from drive 0013's calibration over frames 0-29: 0.27 deg at 1 px, 0.35 at 3 px.
 DEFINE_double(loss_scale_px, kOnline.refine.loss_scale_px, "calibrate: robust-loss scale [px]");
-DEFINE_double(horizontal_weight, kOnline.score.horizontal_weight,
+DEFINE_double(horizontal_weight, kOnline.horizontal_weight,
               "calibrate: weight w of horizontal edges (vertical: 1 - w)");
 DEFINE_double(alpha1_rotation_deg, kOnline.search.alpha1_rotation_deg,
               "search: large rotation step [deg]");

@@ -15,7 +15,6 @@ namespace {
 std::vector<std::shared_ptr<const CalibrationFrame>> LoadKittiFrames(const Drive& drive, int n) {
   FrameSourceOptions options;
   options.suppress_texture = true;
-  options.bandpass_score = false;  // the clipped maps the check's thresholds were set on
   std::vector<int> indices(n);
   for (int i = 0; i < n; ++i) indices[i] = i;
   return testing::LoadCalibrationFrames(drive, options, indices);

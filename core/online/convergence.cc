@@ -7,17 +7,6 @@
 
 namespace stcalib {
 
-std::shared_ptr<const CalibrationFrame> WithSuppressedScoreMaps(const CalibrationFrame& frame) {
-  auto view = std::make_shared<CalibrationFrame>(frame);
-  for (int kind = 0; kind < 2; ++kind) {
-    const cv::Mat& oriented = frame.image.oriented[kind].idt_suppressed;
-    const cv::Mat& map = oriented.empty() ? frame.image.idt_suppressed : oriented;
-    view->score_maps[kind].clear();
-    if (!map.empty()) view->score_maps[kind].push_back(map);
-  }
-  return view;
-}
-
 ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                                     const std::vector<FrameReport>& reports,
                                     const CalibrationState& initial,
@@ -31,7 +20,7 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
   std::vector<const CalibrationFrame*> profile_frames;
   for (const auto& frame : recent) profile_frames.push_back(frame.get());
-  WindowScorer scorer(profile_frames, online.score);
+  WindowScorer scorer(profile_frames, calibrator.options().score);
   verdict.time_offset_profile =
       ProfileTimeOffset(&scorer, verdict.estimate, online.time_offset_bound_s, 0.0025);
   for (int axis = 0; axis < 3; ++axis) {
@@ -155,10 +144,8 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
 
   // The independent check on the texture-suppressed maps of the last frames.
   const size_t keep = std::min<size_t>(recent.size(), options.check_frames);
-  std::vector<std::shared_ptr<const CalibrationFrame>> frames;
-  for (size_t k = recent.size() - keep; k < recent.size(); ++k) {
-    frames.push_back(WithSuppressedScoreMaps(*recent[k]));
-  }
+  const std::vector<std::shared_ptr<const CalibrationFrame>> frames(recent.end() - keep,
+                                                                    recent.end());
   verdict.health_check = CheckCalibrationHealth(frames, verdict.estimate, options.health_check);
   verdict.health_checked = true;
   if (!verdict.health_check.decided || !verdict.health_check.holds) {

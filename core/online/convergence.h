@@ -74,7 +74,4 @@ ConvergenceVerdict JudgeAndPolish(OnlineCalibrator* calibrator,
                                   const OnlineCalibratorOptions& online,
                                   const ConvergenceOptions& options, FrameReport* polish);
 
-// A view of `frame` whose only score map per edge kind is its texture-suppressed IDT.
-std::shared_ptr<const CalibrationFrame> WithSuppressedScoreMaps(const CalibrationFrame& frame);
-
 }  // namespace stcalib

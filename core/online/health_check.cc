@@ -7,6 +7,17 @@
 
 namespace stcalib {
 
+std::shared_ptr<const CalibrationFrame> WithSuppressedScoreMaps(const CalibrationFrame& frame) {
+  auto view = std::make_shared<CalibrationFrame>(frame);
+  for (int kind = 0; kind < 2; ++kind) {
+    const cv::Mat& oriented = frame.image.oriented[kind].idt_suppressed;
+    const cv::Mat& map = oriented.empty() ? frame.image.idt_suppressed : oriented;
+    view->score_maps[kind].clear();
+    if (!map.empty()) view->score_maps[kind].push_back(map);
+  }
+  return view;
+}
+
 Status HealthCheckOptions::Validate() const {
   if (window_frames < 1 || min_windows < 1 || min_points_per_window < 1) {
     return Status::Error("health check: window_frames, min_windows and min points must be >= 1");
@@ -42,7 +53,8 @@ HealthCheckResult CheckCalibrationHealth(
     std::vector<std::shared_ptr<const CalibrationFrame>> pruned;
     std::vector<const CalibrationFrame*> view;
     for (size_t k = begin; k < end; ++k) {
-      pruned.push_back(PruneToImage(*frames[k], calibration, options.point_margin));
+      pruned.push_back(
+          WithSuppressedScoreMaps(*PruneToImage(*frames[k], calibration, options.point_margin)));
       view.push_back(pruned.back().get());
       window.points += static_cast<int>(pruned.back()->size());
     }

@@ -56,9 +56,14 @@ struct HealthCheckResult {
   std::string reason;  ///< the verdict or why there is none, in words
 };
 
-// `frames` in time order (consecutive windows of window_frames are scored).
+// `frames` in time order (consecutive windows of window_frames are scored). Whatever score maps
+// the frames carry, each is scored on its clipped texture-suppressed IDT (the maps the
+// thresholds above were measured on).
 HealthCheckResult CheckCalibrationHealth(
     const std::vector<std::shared_ptr<const CalibrationFrame>>& frames,
     const CalibrationState& calibration, const HealthCheckOptions& options);
+
+// A view of `frame` whose only score map per edge kind is its clipped texture-suppressed IDT.
+std::shared_ptr<const CalibrationFrame> WithSuppressedScoreMaps(const CalibrationFrame& frame);
 
 }  // namespace stcalib

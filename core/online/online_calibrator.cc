@@ -30,13 +30,11 @@ CalibrationState KeepObservableAxes(const CalibrationState& old, const Calibrati
   return Step(old, r, t, observable[6] ? candidate.time_offset_s - old.time_offset_s : 0.0);
 }
 
-OnlineCalibratorOptions::OnlineCalibratorOptions() {
-  score.horizontal_weight = 0.2;
-  refine.horizontal_weight = 0.2;
-}
-
 Status OnlineCalibratorOptions::Validate() const {
   if (window_frames < 1) return Status::Error("online: window_frames must be >= 1");
+  if (!(horizontal_weight >= 0 && horizontal_weight <= 1)) {
+    return Status::Error("online: horizontal_weight must be in [0, 1]");
+  }
   STCALIB_RETURN_IF_ERROR(search.Validate());
   return refine.Validate();
 }
@@ -47,6 +45,8 @@ OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
   CHECK(options_.Validate().ok()) << options_.Validate().message();
   options_.search.time_offset_bound_s = options_.time_offset_bound_s;
   options_.refine.time_offset_bound_s = options_.time_offset_bound_s;
+  options_.score.horizontal_weight = options_.horizontal_weight;
+  options_.refine.horizontal_weight = options_.horizontal_weight;
   state_.time_offset_s =
       std::clamp(state_.time_offset_s, -options_.time_offset_bound_s, options_.time_offset_bound_s);
   anchor_ = state_;

@@ -17,21 +17,21 @@ namespace stcalib {
 struct OnlineCalibratorOptions {
   // The defaults are set for real streets (KITTI drive 0013, tree-lined) and serve simulated
   // drives as well; `stcalib calibrate`'s flags take their defaults from here.
-  OnlineCalibratorOptions();
-
   int window_frames = 3;  ///< sliding window of frames searched together
   // A few frames can prefer a side peak 3.5° off (drive 0013, frames 10-16): refine on 20. (An
   // acquisition ends only when the grid agrees with the estimate on a full refinement window:
   // drives shorter than about refine_frames + 5 frames want fewer.)
   int refine_frames = 20;  ///< the refinement uses this many latest frames
-  // Horizontal LiDAR edges are the less faithful ones (foliage tops scatter; the tops of cars
-  // seen from above show a roof sliver in the image): at w = 0.5 the first 8 frames of drive 0013
-  // sat on a side peak 4-6° off, at w = 0.2 they are 0.2-0.7° off by frame 5; over all 30 frames
-  // the score peaks at the same roll and yaw for any w in [0, 1]. The constructor sets w = 0.2
-  // in both `score` and `refine`.
+  // The calibrator sets score.horizontal_weight, refine.horizontal_weight and both
+  // time_offset_bound_s from the fields below (one setting, one home).
   ScoreOptions score;
   AdaptiveGridSearchOptions search;
   RefineOptions refine;
+  // Horizontal LiDAR edges are the less faithful ones (foliage tops scatter; the tops of cars
+  // seen from above show a roof sliver in the image): at w = 0.5 the first 8 frames of drive 0013
+  // sat on a side peak 4-6° off, at w = 0.2 they are 0.2-0.7° off by frame 5; over all 30 frames
+  // the score peaks at the same roll and yaw for any w in [0, 1].
+  double horizontal_weight = 0.2;     ///< w of method.md §6, for the score and the refinement
   double time_offset_bound_s = 0.15;  ///< |δ| bound for search and refinement [s]
   // Health (method.md §7) below this at the current estimate, or a window not yet full, means
   // the estimate may be far off: the search runs coarse-to-fine from the widest map instead of
@@ -110,6 +110,8 @@ class OnlineCalibrator {
   // A frame the caller could not load: recorded as skipped with `why`.
   FrameReport SkipFrame(int frame, const std::string& why) const;
   const CalibrationState& state() const { return state_; }
+  // The options in effect (the shared settings copied into score, search and refine).
+  const OnlineCalibratorOptions& options() const { return options_; }
   // Still acquiring (OnlineCalibratorOptions::acquire_with_grid with a grid): the rotation grid
   // has not yet agreed with the estimate on a full refinement window.
   bool acquiring() const {
