@@ -81,6 +81,30 @@ TEST(ImageFeatures, BlackImageGivesEmptyFeaturesNotACrash) {
   EXPECT_TRUE(ExtractImageFeatures(cv::Mat(), options).empty());
 }
 
+// With split orientation the pyramid levels are the oriented maps' own (an unsplit pyramid would
+// be read by nothing): each level is the IDT of that orientation's distances at the level's
+// basin, texture-suppressed.
+TEST(ImageFeatures, SplitOrientationBuildsThePyramidOnTheOrientedMapsOnly) {
+  cv::Mat image(120, 200, CV_8UC3, cv::Scalar::all(60));
+  cv::rectangle(image, cv::Rect(50, 30, 60, 50), cv::Scalar::all(200), cv::FILLED);
+  ImageFeatureOptions options;
+  options.split_orientation = true;
+  options.pyramid_basins_px = {40, 20};
+  const ImageFeatures f = ExtractImageFeatures(image, options);
+  ASSERT_FALSE(f.empty());
+  EXPECT_TRUE(f.idt_pyramid.empty());
+  const cv::Mat* raw[2] = {&f.distance_vertical_raw_px, &f.distance_horizontal_raw_px};
+  for (int o = 0; o < 2; ++o) {
+    ASSERT_EQ(f.oriented[o].pyramid.size(), 2u);
+    for (size_t i = 0; i < 2; ++i) {
+      const double basin = options.pyramid_basins_px[i];
+      const cv::Mat expected = SuppressTexture(InverseDistanceTransform(*raw[o], basin, basin / 10),
+                                               std::max(12.0, 2 * basin));
+      EXPECT_EQ(cv::norm(f.oriented[o].pyramid[i], expected, cv::NORM_INF), 0.0) << o << " " << i;
+    }
+  }
+}
+
 // The band-pass map (BandPass) averages to zero over dense texture, so moving points into a
 // textured region gains nothing; the clipped map (SuppressTexture) keeps the positive half-wave
 // and rewards it. An isolated edge is a positive peak in both.

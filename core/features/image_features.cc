@@ -48,6 +48,12 @@ std::vector<cv::Vec4f> DetectSegments(const cv::Mat& gray, const ImageFeatureOpt
   return segments;
 }
 
+// With split orientation the oriented maps carry their own pyramids; an unsplit one would be two
+// wide blurs per level that nothing reads.
+size_t UnsplitPyramidLevels(const ImageFeatureOptions& options) {
+  return options.split_orientation ? 0 : options.pyramid_basins_px.size();
+}
+
 }  // namespace
 
 Status ImageFeatureOptions::Validate() const {
@@ -138,7 +144,7 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     features.idt = embed(crop.idt, CV_32F, 0);
     features.idt_suppressed = embed(crop.idt_suppressed, CV_32F, 0);
     features.idt_bandpass = embed(crop.idt_bandpass, CV_32F, 0);
-    for (size_t i = 0; i < options.pyramid_basins_px.size(); ++i) {
+    for (size_t i = 0; i < UnsplitPyramidLevels(options); ++i) {
       features.idt_pyramid.push_back(
           embed(i < crop.idt_pyramid.size() ? crop.idt_pyramid[i] : cv::Mat(), CV_32F, 0));
     }
@@ -182,7 +188,7 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     features.idt = cv::Mat::zeros(gray.size(), CV_32F);
     features.idt_suppressed = features.idt.clone();
     features.idt_bandpass = features.idt.clone();
-    for (size_t i = 0; i < options.pyramid_basins_px.size(); ++i) {
+    for (size_t i = 0; i < UnsplitPyramidLevels(options); ++i) {
       features.idt_pyramid.push_back(features.idt.clone());
     }
     return features;
@@ -207,7 +213,8 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
   features.idt = InverseDistanceTransform(distance, options.basin_px, options.smoothing_sigma_px);
   features.idt_bandpass = BandPass(features.idt, options.suppression_sigma_px);
   cv::max(features.idt_bandpass, 0.0, features.idt_suppressed);
-  for (double basin : options.pyramid_basins_px) {
+  for (size_t i = 0; i < UnsplitPyramidLevels(options); ++i) {
+    const double basin = options.pyramid_basins_px[i];
     cv::Mat level =
         InverseDistanceTransform(distance, basin, std::max(options.smoothing_sigma_px, basin / 10));
     if (options.suppress_pyramid) {

@@ -63,7 +63,8 @@ struct ImageFeatures {
   cv::Mat idt;                         ///< CV_32F, smoothed IDT in [0, 255]
   cv::Mat idt_suppressed;  ///< CV_32F, max(0, IDT − wide blur of IDT): dense texture fades
   cv::Mat idt_bandpass;    ///< CV_32F, IDT − wide blur of IDT, not clipped (see BandPass)
-  std::vector<cv::Mat> idt_pyramid;  ///< IDTs at pyramid_basins_px (suppressed if asked)
+  std::vector<cv::Mat> idt_pyramid;  ///< IDTs at pyramid_basins_px (suppressed if asked);
+                                     ///< empty with split_orientation (see OrientedMaps)
   std::vector<cv::Vec4f> segments;   ///< line segments at full-size coordinates (LSD/FLD)
   // With split_orientation: the maps of near-vertical [0] and near-horizontal [1] edges.
   std::array<OrientedMaps, 2> oriented;
