@@ -115,7 +115,7 @@ void BM_Refine(benchmark::State& state) {
   if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
   const CalibrationState initial = KittiCalibration();
   const std::vector<const CalibrationFrame*> frames = FirstFrames(state.range(0));
-  const RefineOptions options = OnlineCalibratorOptions().refine;
+  const RefineOptions options = WithSharedSettings(OnlineCalibratorOptions()).refine;
   int iterations = 0;
   for (auto _ : state) {
     const RefineResult r = Refine(frames, initial, initial, initial, options);

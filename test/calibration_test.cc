@@ -66,6 +66,24 @@ TEST(OnlineCalibrator, RefusesBadFramesAndKeepsTheEstimate) {
   EXPECT_EQ(calibrator.state().time_offset_s, start.time_offset_s);
 }
 
+// The shared settings reach every stage: the calibrator scores and refines with its one
+// horizontal-edge weight and its one δ bound, whatever the sub-structs held.
+TEST(OnlineCalibrator, SharedSettingsReachScoreSearchAndRefine) {
+  OnlineCalibratorOptions options;
+  options.horizontal_weight = 0.35;
+  options.time_offset_bound_s = 0.07;
+  options.score.horizontal_weight = 0.9;
+  options.refine.horizontal_weight = 0.1;
+  const OnlineCalibrator calibrator(options, CalibrationState());
+  EXPECT_EQ(calibrator.options().score.horizontal_weight, 0.35);
+  EXPECT_EQ(calibrator.options().refine.horizontal_weight, 0.35);
+  EXPECT_EQ(calibrator.options().search.time_offset_bound_s, 0.07);
+  EXPECT_EQ(calibrator.options().refine.time_offset_bound_s, 0.07);
+  // Out of [0, 1]: a user error, reported by Validate.
+  options.horizontal_weight = 1.5;
+  EXPECT_FALSE(options.Validate().ok());
+}
+
 TEST(Calibration, StagesAgainstSimulatedTruth) {
   testing::ScopedTempDir tmp;
   sim::SimulatorOptions sim_options;

@@ -39,14 +39,19 @@ Status OnlineCalibratorOptions::Validate() const {
   return refine.Validate();
 }
 
+OnlineCalibratorOptions WithSharedSettings(const OnlineCalibratorOptions& options) {
+  OnlineCalibratorOptions out = options;
+  out.search.time_offset_bound_s = options.time_offset_bound_s;
+  out.refine.time_offset_bound_s = options.time_offset_bound_s;
+  out.score.horizontal_weight = options.horizontal_weight;
+  out.refine.horizontal_weight = options.horizontal_weight;
+  return out;
+}
+
 OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
                                    const CalibrationState& initial)
-    : options_(options), state_(initial) {
+    : options_(WithSharedSettings(options)), state_(initial) {
   CHECK(options_.Validate().ok()) << options_.Validate().message();
-  options_.search.time_offset_bound_s = options_.time_offset_bound_s;
-  options_.refine.time_offset_bound_s = options_.time_offset_bound_s;
-  options_.score.horizontal_weight = options_.horizontal_weight;
-  options_.refine.horizontal_weight = options_.horizontal_weight;
   state_.time_offset_s =
       std::clamp(state_.time_offset_s, -options_.time_offset_bound_s, options_.time_offset_bound_s);
   anchor_ = state_;

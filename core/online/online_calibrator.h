@@ -22,8 +22,8 @@ struct OnlineCalibratorOptions {
   // acquisition ends only when the grid agrees with the estimate on a full refinement window:
   // drives shorter than about refine_frames + 5 frames want fewer.)
   int refine_frames = 20;  ///< the refinement uses this many latest frames
-  // The calibrator sets score.horizontal_weight, refine.horizontal_weight and both
-  // time_offset_bound_s from the fields below (one setting, one home).
+  // score.horizontal_weight, refine.horizontal_weight and both time_offset_bound_s are set from
+  // the fields below (one setting, one home) by WithSharedSettings, which the calibrator applies.
   ScoreOptions score;
   AdaptiveGridSearchOptions search;
   RefineOptions refine;
@@ -100,6 +100,11 @@ CalibrationState KeepObservableAxes(const CalibrationState& old, const Calibrati
 // over the window; an update is taken only when the window score does not get worse and the axes
 // it moves are observable (an unobservable axis keeps its value); |δ| stays within its bound.
 // It only sequences the stages; the maths lives in score/, search/ and refine/.
+// `options` with its shared settings (horizontal_weight, time_offset_bound_s) copied into score,
+// search and refine: the options an OnlineCalibrator runs with. Use it to run a stage alone
+// with the calibrator's settings.
+OnlineCalibratorOptions WithSharedSettings(const OnlineCalibratorOptions& options);
+
 class OnlineCalibrator {
  public:
   OnlineCalibrator(const OnlineCalibratorOptions& options, const CalibrationState& initial);
