@@ -32,8 +32,8 @@ using DistanceInterpolator = ceres::BiCubicInterpolator<DistanceGrid>;
 // with D the smoothed distance map read by a bicubic interpolator, P | p4 = P_rect_02 and w the
 // point's weight (horizontal and vertical edges weighted w and 1 − w). The residual is in pixels.
 //
-// Jacobians (analytic; autodiff through the motion model's sines and the quaternion cost about
-// 5x more per residual, and the residuals are most of a refinement's time). With
+// Jacobians (analytic: with autodiff through the motion model's sines and the quaternion, a
+// 12-frame KITTI refinement took 188 ms instead of 41-46 ms, BM_Refine/12). With
 // g = √w · [∂D/∂u, ∂D/∂v] and A = ∂(u, v)/∂h · P · R_rect, ∂(u, v)/∂h = [1/h_z, 0, −h_x/h_z²;
 // 0, 1/h_z, −h_y/h_z²], the row J = g · A = ∂r/∂p_c, and
 //   ∂r/∂t = J;
