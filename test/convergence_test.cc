@@ -49,7 +49,7 @@ TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
       pruned.push_back(PruneToImage(*plain[k], wrong, check.point_margin));
       view.push_back(pruned.back().get());
     }
-    WindowScorer scorer(view, ScoreOptions());
+    WindowScorer scorer(view, check.score);
     plain_wrong_health +=
         HealthScore(&scorer, wrong, check.rotation_step_deg, check.translation_step_m);
     ++windows;

@@ -4,6 +4,7 @@
 #include <ceres/product_manifold.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -157,6 +158,22 @@ TEST(EdgeAlignmentCost, NominalValueByHand) {
                                  map.interpolator.get(), 20.0);
   ASSERT_TRUE(behind.Evaluate(params, &residual, nullptr));
   EXPECT_DOUBLE_EQ(residual, 40.0);
+  // ... with zero derivatives, whichever blocks are asked for.
+  double j_pose[7], j_delta = 1.0;
+  std::fill(j_pose, j_pose + 7, 1.0);
+  double* both[2] = {j_pose, &j_delta};
+  ASSERT_TRUE(behind.Evaluate(params, &residual, both));
+  for (double j : j_pose) EXPECT_EQ(j, 0.0);
+  EXPECT_EQ(j_delta, 0.0);
+  j_delta = 1.0;
+  double* delta_only[2] = {nullptr, &j_delta};
+  ASSERT_TRUE(behind.Evaluate(params, &residual, delta_only));
+  EXPECT_EQ(j_delta, 0.0);
+  // Inside the image, only the asked-for block is written.
+  std::fill(j_pose, j_pose + 7, 0.0);
+  double* pose_only[2] = {j_pose, nullptr};
+  ASSERT_TRUE(cost.Evaluate(params, &residual, pose_only));
+  EXPECT_NE((Eigen::Map<Eigen::Matrix<double, 7, 1>>(j_pose).norm()), 0.0);
 }
 
 TEST(EdgeAlignmentCost, JacobiansMatchNumericDifferentiation) {
@@ -175,8 +192,8 @@ TEST(EdgeAlignmentCost, JacobiansMatchNumericDifferentiation) {
     const Rigid3d T = PerturbTcameraLidar(MakeRigid(R0, Eigen::Vector3d(0.05, -0.08, -0.27)),
                                           Eigen::Vector3d(unit(rng), unit(rng), unit(rng)),
                                           0.05 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng)));
-    // A quaternion of norm 0.8–1.25: the residual depends on the rotation only, and the ambient
-    // Jacobian must say so.
+    // A quaternion of norm 0.75–1.25: the residual depends on the rotation only, so the ambient
+    // Jacobian has no component along q (checked below) and scales with 1/|q|.
     const Eigen::Quaterniond q(T.linear());
     const double s = 1.0 + 0.25 * unit(rng);
     double pose[7] = {s * q.x(),           s * q.y(),           s * q.z(),          s * q.w(),
@@ -192,6 +209,11 @@ TEST(EdgeAlignmentCost, JacobiansMatchNumericDifferentiation) {
     // Tolerance: the map is stored in float and the bicubic stencil amplifies its rounding in
     // the finite differences (≈1e-6 relative); the Jacobian itself is exact.
     EXPECT_LT(WorstTangentJacobianError(*cost, pose, &delta), 1e-4) << "trial " << trial;
+    double j_pose[7], j_delta;
+    double* jacobians[2] = {j_pose, &j_delta};
+    ASSERT_TRUE(cost->Evaluate(params, &residual, jacobians));
+    const Eigen::Map<const Eigen::Vector4d> j_q(j_pose), q_coeffs(pose);
+    EXPECT_LT(std::abs(j_q.dot(q_coeffs)), 1e-9 * std::max(1.0, j_q.norm())) << "trial " << trial;
     ++checked;
   }
   EXPECT_GT(checked, 30);

@@ -79,6 +79,17 @@ TEST(ImageFeatures, BlackImageGivesEmptyFeaturesNotACrash) {
   EXPECT_EQ(cv::countNonZero(f.idt), 0);
   EXPECT_EQ(f.idt_pyramid.size(), 2u);
   EXPECT_TRUE(ExtractImageFeatures(cv::Mat(), options).empty());
+  // Split by orientation: the oriented maps exist and are flat, with their pyramid levels.
+  options.split_orientation = true;
+  const ImageFeatures split = ExtractImageFeatures(cv::Mat::zeros(50, 80, CV_8UC3), options);
+  EXPECT_TRUE(split.idt_pyramid.empty());
+  for (const OrientedMaps& m : split.oriented) {
+    ASSERT_EQ(m.pyramid.size(), 2u);
+    EXPECT_EQ(m.idt.size(), cv::Size(80, 50));
+    EXPECT_EQ(cv::countNonZero(m.idt_bandpass), 0);
+    EXPECT_EQ(cv::countNonZero(m.pyramid[1]), 0);
+    EXPECT_EQ(cv::countNonZero(m.distance_px != options.basin_px), 0);
+  }
 }
 
 // With split orientation the pyramid levels are the oriented maps' own (an unsplit pyramid would

@@ -191,6 +191,17 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     for (size_t i = 0; i < UnsplitPyramidLevels(options); ++i) {
       features.idt_pyramid.push_back(features.idt.clone());
     }
+    if (options.split_orientation) {  // the same maps as with edges, all flat
+      for (OrientedMaps& m : features.oriented) {
+        m.idt = features.idt.clone();
+        m.idt_suppressed = features.idt.clone();
+        m.idt_bandpass = features.idt.clone();
+        m.distance_px = features.distance_px.clone();
+        for (size_t i = 0; i < options.pyramid_basins_px.size(); ++i) {
+          m.pyramid.push_back(features.idt.clone());
+        }
+      }
+    }
     return features;
   }
 
