@@ -44,7 +44,7 @@ TEST(Projection, RectificationRotationIsApplied) {
   camera.R_rect_00 = Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()).toRotationMatrix();
   Eigen::Vector2d pixel;
   double depth = 0;
-  ASSERT_TRUE(camera.Project<double>(Eigen::Vector3d(0, 0, 10), &pixel, &depth));
+  ASSERT_TRUE(camera.Project(Eigen::Vector3d(0, 0, 10), &pixel, &depth));
   // R_y(0.1)·(0,0,10) = (10 sin 0.1, 0, 10 cos 0.1) → u = 50 + 100·tan(0.1).
   EXPECT_NEAR(pixel.x(), 50 + 100 * std::tan(0.1), 1e-9);
   EXPECT_NEAR(pixel.y(), 50, 1e-9);

@@ -48,7 +48,7 @@ inline bool ProjectFramePoint(const CalibrationFrame& frame, const CalibrationSt
       state.T_camera_lidar * ApplyLidarMotion<double>(frame.twist, frame.e0_s + state.time_offset_s,
                                                       frame.points_lidar[i]);
   double depth;
-  return frame.camera.Project<double>(p, pixel, &depth);
+  return frame.camera.Project(p, pixel, &depth);
 }
 
 }  // namespace stcalib

@@ -17,7 +17,7 @@ std::vector<ProjectedPoint> ProjectPoints(const CameraModel& camera, const Rigid
   projected.reserve(points_lidar.size() / 4);
   for (size_t i = 0; i < points_lidar.size(); ++i) {
     ProjectedPoint p;
-    if (!camera.Project<double>(T_camera_lidar * points_lidar[i], &p.pixel, &p.depth_m)) continue;
+    if (!camera.Project(T_camera_lidar * points_lidar[i], &p.pixel, &p.depth_m)) continue;
     if (!camera.InImage(p.pixel)) continue;
     p.index = static_cast<int>(i);
     projected.push_back(p);
