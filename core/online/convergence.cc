@@ -108,6 +108,14 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
     verdict.reason = "not converged: " + std::to_string(verdict.used_frames) +
                      " usable frame(s) cannot show that the estimate has settled (" +
                      std::to_string(options.min_frames) + " needed)";
+    const OnlineCalibratorOptions& in_effect = calibrator.options();
+    if (in_effect.wait_for_full_window && verdict.used_frames < in_effect.window_frames) {
+      // Not even one update: say so, or the start would read as an estimate.
+      verdict.reason += "; fewer frames than the search window's " +
+                        std::to_string(in_effect.window_frames) +
+                        ", so the estimate was never updated (a search window of 1 frame "
+                        "estimates from a single frame)";
+    }
   } else if (calibrator.acquiring()) {
     verdict.reason =
         "not converged: still acquiring (the rotation grid around the initial "
