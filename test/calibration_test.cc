@@ -164,6 +164,41 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   EXPECT_LT(std::abs(grid_error.yaw_deg), 0.5);
   EXPECT_GT(grid.score, scorer.Evaluate(start_true_delta, -1).score);
 
+  // The grid's cache (the calibrator's while acquiring): on a window growing one frame at a time
+  // and then sliding, the cached grid gives the uncached grid's result bit for bit and scores
+  // each frame once; another translation scores them all again.
+  {
+    RotationGridCache cache;
+    auto grid_on = [&](size_t first, size_t count, const CalibrationState& centre,
+                       RotationGridCache* with) {
+      WindowScorer part(std::vector<const CalibrationFrame*>(window.begin() + first,
+                                                             window.begin() + first + count),
+                        ScoreOptions());
+      return RotationGridSearch(&part, centre, start_true_delta, AdaptiveGridSearchOptions(), 3.0,
+                                0.5, -1, with);
+    };
+    const std::pair<size_t, size_t> windows[] = {{0, 1}, {0, 2}, {0, 3}, {1, 3}};
+    const int scored_after[] = {1, 2, 3, 4};
+    for (int k = 0; k < 4; ++k) {
+      const auto [first, count] = windows[k];
+      const RotationGridResult cached = grid_on(first, count, start_true_delta, &cache);
+      const RotationGridResult fresh = grid_on(first, count, start_true_delta, nullptr);
+      EXPECT_EQ(cached.score, fresh.score) << k;
+      EXPECT_EQ(cached.state.T_camera_lidar.matrix(), fresh.state.T_camera_lidar.matrix()) << k;
+      EXPECT_EQ(cached.evaluations, 13 * 13 * 13);
+      EXPECT_EQ(cache.frames_scored(), scored_after[k]) << k;
+      // The sum of per-frame scores is the window's score.
+      WindowScorer part(std::vector<const CalibrationFrame*>(window.begin() + first,
+                                                             window.begin() + first + count),
+                        ScoreOptions());
+      EXPECT_NEAR(cached.score, part.Evaluate(cached.state, -1).score, 1e-9 * cached.score);
+    }
+    const CalibrationState moved =
+        Step(start_true_delta, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.01, 0, 0), 0.0);
+    grid_on(1, 3, moved, &cache);
+    EXPECT_EQ(cache.frames_scored(), 4 + 3);
+  }
+
   // Refinement over eight frames from a small error: closer to the truth, with a covariance.
   std::vector<const CalibrationFrame*> long_window;
   for (size_t i = 2; i < frames.size(); ++i) long_window.push_back(frames[i].get());

@@ -213,7 +213,7 @@ void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
     centre.T_camera_lidar.linear() = anchor_.T_camera_lidar.linear();
     const RotationGridResult grid =
         RotationGridSearch(long_scorer, centre, anchor_, *search_options, options_.lost_grid_deg,
-                           options_.lost_grid_step_deg);
+                           options_.lost_grid_step_deg, -1, &grid_cache_);
     grid_evaluations = grid.evaluations;
     // Agreement: the estimate is within one lattice step (diagonals included) of the grid's
     // best point, i.e. on the same peak.

@@ -178,6 +178,9 @@ class OnlineCalibrator {
   double last_health_ = 0;  ///< health after the last updated frame
   CalibrationState last_healthy_;
   std::deque<std::shared_ptr<const CalibrationFrame>> window_;  // the last refine_frames frames
+  // The rotation grid's per-frame scores: while acquiring the grid runs on a window that grows
+  // by one frame, and each frame is scored once as long as the translation and δ stay put.
+  RotationGridCache grid_cache_;
   double last_camera_time_s_ = -std::numeric_limits<double>::infinity();
 };
 

@@ -77,29 +77,48 @@ const std::vector<Eigen::Vector3d>& WindowScorer::Moved(size_t frame, double tim
   return moved_[frame];
 }
 
+const cv::Mat& WindowScorer::LevelMap(const CalibrationFrame& cf, int kind, int level) {
+  const int maps = static_cast<int>(cf.score_maps[kind].size());
+  const int l = level < 0 ? maps + level : level;
+  CHECK(l >= 0 && l < maps) << "score level " << level << " of " << maps;
+  return cf.score_maps[kind][l];
+}
+
 ScoreValue WindowScorer::Evaluate(const CalibrationState& state, int level) {
-  return EvaluateOn(state, [level](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
-    const int maps = static_cast<int>(cf.score_maps[kind].size());
-    const int l = level < 0 ? maps + level : level;
-    CHECK(l >= 0 && l < maps) << "score level " << level << " of " << maps;
-    return cf.score_maps[kind][l];
-  });
+  return EvaluateOn(
+      state,
+      [level](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
+        return LevelMap(cf, kind, level);
+      },
+      0, frames_.size());
+}
+
+ScoreValue WindowScorer::EvaluateFrame(size_t f, const CalibrationState& state, int level) {
+  CHECK_LT(f, frames_.size());
+  return EvaluateOn(
+      state,
+      [level](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
+        return LevelMap(cf, kind, level);
+      },
+      f, f + 1);
 }
 
 double WindowScorer::GrayRate(const CalibrationState& state) {
-  return EvaluateOn(state,
-                    [](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
-                      return cf.gray_map[kind].empty() ? cf.score_maps[kind].back()
-                                                       : cf.gray_map[kind];
-                    })
+  return EvaluateOn(
+             state,
+             [](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
+               return cf.gray_map[kind].empty() ? cf.score_maps[kind].back() : cf.gray_map[kind];
+             },
+             0, frames_.size())
       .gray_rate;
 }
 
 template <typename MapOf>
-ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& map_of) {
+ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& map_of,
+                                    size_t begin, size_t end) {
   ScoreValue value;
   double weight_sum = 0;
-  for (size_t f = 0; f < frames_.size(); ++f) {
+  for (size_t f = begin; f < end; ++f) {
     const CalibrationFrame& cf = *frames_[f];
     const cv::Mat* maps[2] = {&map_of(cf, 0), &map_of(cf, 1)};
     const std::vector<Eigen::Vector3d>& moved = Moved(f, state.time_offset_s);

@@ -36,6 +36,11 @@ class WindowScorer {
   double GrayRate(const CalibrationState& state);
   int num_levels() const;
   size_t num_frames() const { return frames_.size(); }
+  const CalibrationFrame& frame(size_t f) const { return *frames_[f]; }
+  const ScoreOptions& options() const { return options_; }
+  // Evaluate() on frame `f` alone. The window's score is the sum of these in frame order up to
+  // rounding (Evaluate() accumulates point by point across frames).
+  ScoreValue EvaluateFrame(size_t f, const CalibrationState& state, int level);
 
  private:
   struct FramePoints {
@@ -43,9 +48,12 @@ class WindowScorer {
     std::vector<float> weight;
   };
   const std::vector<Eigen::Vector3d>& Moved(size_t frame, double time_offset_s);
-  // Evaluates on the map `map_of(frame, kind)`.
+  // Evaluates frames [begin, end) on the map `map_of(frame, kind)`.
   template <typename MapOf>
-  ScoreValue EvaluateOn(const CalibrationState& state, const MapOf& map_of);
+  ScoreValue EvaluateOn(const CalibrationState& state, const MapOf& map_of, size_t begin,
+                        size_t end);
+  // The map of `level` (negative counts from the finest: −1) for one kind of edge.
+  static const cv::Mat& LevelMap(const CalibrationFrame& cf, int kind, int level);
 
   std::vector<const CalibrationFrame*> frames_;
   ScoreOptions options_;

@@ -162,32 +162,83 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
   return result;
 }
 
+bool RotationGridCache::Lattice::operator==(const Lattice& o) const {
+  return center == o.center && anchor == o.anchor &&
+         center_time_offset_s == o.center_time_offset_s &&
+         anchor_time_offset_s == o.anchor_time_offset_s && half_range_deg == o.half_range_deg &&
+         step_deg == o.step_deg && level == o.level && horizontal_weight == o.horizontal_weight &&
+         max_points_per_frame == o.max_points_per_frame && in_bounds == o.in_bounds;
+}
+
 RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationState& center,
                                       const CalibrationState& anchor,
                                       const AdaptiveGridSearchOptions& options,
-                                      double half_range_deg, double step_deg, int level) {
+                                      double half_range_deg, double step_deg, int level,
+                                      RotationGridCache* cache) {
   CHECK(half_range_deg >= 0 && step_deg > 0) << half_range_deg << " " << step_deg;
-  RotationGridResult result;
-  result.state = center;
-  result.score = scorer->Evaluate(center, level).score;
-  result.evaluations = 1;
+  // The lattice: the centre first, then the offsets in order, those outside the bounds skipped.
   const int n = static_cast<int>(std::floor(half_range_deg / step_deg + 1e-9));
+  std::vector<CalibrationState> points = {center};
+  std::vector<uint8_t> in_bounds = {1};
   for (int a = -n; a <= n; ++a) {
     for (int b = -n; b <= n; ++b) {
       for (int c = -n; c <= n; ++c) {
         if (a == 0 && b == 0 && c == 0) continue;
-        const CalibrationState candidate = Step(
-            center, Eigen::Vector3d(a, b, c) * step_deg * kDegToRad, Eigen::Vector3d::Zero(), 0.0);
-        if (!WithinBounds(candidate, anchor, options)) continue;
-        const double value = scorer->Evaluate(candidate, level).score;
-        ++result.evaluations;
-        if (value > result.score) {
-          result.score = value;
-          result.state = candidate;
-        }
+        points.push_back(Step(center, Eigen::Vector3d(a, b, c) * step_deg * kDegToRad,
+                              Eigen::Vector3d::Zero(), 0.0));
+        in_bounds.push_back(WithinBounds(points.back(), anchor, options) ? 1 : 0);
       }
     }
   }
+  RotationGridCache local;
+  if (cache == nullptr) cache = &local;
+  RotationGridCache::Lattice lattice{center.T_camera_lidar.matrix(),
+                                     anchor.T_camera_lidar.matrix(),
+                                     center.time_offset_s,
+                                     anchor.time_offset_s,
+                                     half_range_deg,
+                                     step_deg,
+                                     level,
+                                     scorer->options().horizontal_weight,
+                                     scorer->options().max_points_per_frame,
+                                     std::move(in_bounds)};
+  if (!cache->valid_ || !(cache->lattice_ == lattice)) {
+    cache->scores_.clear();
+    cache->lattice_ = std::move(lattice);
+    cache->valid_ = true;
+  }
+  const std::vector<uint8_t>& mask = cache->lattice_.in_bounds;
+  // Per-frame scores, from the cache or computed; frames no longer in the window forgotten.
+  std::map<RotationGridCache::FrameKey, std::vector<double>> kept;
+  std::vector<const std::vector<double>*> frame_scores;
+  for (size_t f = 0; f < scorer->num_frames(); ++f) {
+    const CalibrationFrame& frame = scorer->frame(f);
+    const RotationGridCache::FrameKey key{frame.index, frame.camera_time_s, frame.size()};
+    auto it = cache->scores_.find(key);
+    std::vector<double> scores;
+    if (it != cache->scores_.end()) {
+      scores = std::move(it->second);
+    } else {
+      scores.assign(points.size(), 0.0);
+      for (size_t i = 0; i < points.size(); ++i) {
+        if (mask[i]) scores[i] = scorer->EvaluateFrame(f, points[i], level).score;
+      }
+      ++cache->frames_scored_;
+    }
+    frame_scores.push_back(&kept.emplace(key, std::move(scores)).first->second);
+  }
+  RotationGridResult result;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!mask[i]) continue;
+    double value = 0;
+    for (const std::vector<double>* s : frame_scores) value += (*s)[i];
+    ++result.evaluations;
+    if (i == 0 || value > result.score) {
+      result.score = value;
+      result.state = points[i];
+    }
+  }
+  cache->scores_ = std::move(kept);
   return result;
 }
 

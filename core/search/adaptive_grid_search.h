@@ -1,6 +1,10 @@
 #pragma once
 
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/score/score.h"
@@ -67,10 +71,53 @@ struct RotationGridResult {
   double score = 0;        ///< its score on `level`
   int evaluations = 0;
 };
+// Per-frame scores of RotationGridSearch's lattice, kept from one call to the next. While
+// acquiring, the calibrator runs the grid on a window that grows by one frame per call; as long
+// as the lattice (centre, anchor, range, step, level, bounds) and the score options stay the
+// same, a frame scored by an earlier call is not scored again. A frame is known by its index,
+// camera stamp and number of points; frames that left the window are forgotten.
+class RotationGridCache {
+ public:
+  // Frames scored over the whole lattice since construction (the work the cache did not save).
+  int frames_scored() const { return frames_scored_; }
+
+ private:
+  friend RotationGridResult RotationGridSearch(WindowScorer*, const CalibrationState&,
+                                               const CalibrationState&,
+                                               const AdaptiveGridSearchOptions&, double, double,
+                                               int, RotationGridCache*);
+  struct FrameKey {
+    int index;
+    double camera_time_s;
+    size_t points;
+    bool operator<(const FrameKey& o) const {
+      return std::tie(index, camera_time_s, points) < std::tie(o.index, o.camera_time_s, o.points);
+    }
+  };
+  // What the per-frame scores depend on besides the frame; compared exactly.
+  struct Lattice {
+    Eigen::Matrix4d center, anchor;
+    double center_time_offset_s, anchor_time_offset_s, half_range_deg, step_deg;
+    int level;
+    double horizontal_weight;
+    int max_points_per_frame;
+    std::vector<uint8_t> in_bounds;  // per lattice point
+    bool operator==(const Lattice& o) const;
+  };
+  Lattice lattice_;
+  bool valid_ = false;
+  std::map<FrameKey, std::vector<double>> scores_;  // per lattice point (0 when out of bounds)
+  int frames_scored_ = 0;
+};
+
+// `cache` (optional): reuse the per-frame scores of earlier calls (see RotationGridCache). The
+// result is the same with or without it: the window's score at a lattice point is the sum of
+// its per-frame scores in frame order either way.
 RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationState& center,
                                       const CalibrationState& anchor,
                                       const AdaptiveGridSearchOptions& options,
-                                      double half_range_deg, double step_deg, int level = -1);
+                                      double half_range_deg, double step_deg, int level = -1,
+                                      RotationGridCache* cache = nullptr);
 
 // True when `state` is within the rotation/translation bounds around `anchor`.
 bool WithinBounds(const CalibrationState& state, const CalibrationState& anchor,
