@@ -97,6 +97,33 @@ void BM_RotationGrid(benchmark::State& state) {
 }
 BENCHMARK(BM_RotationGrid)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
 
+// The same grid as the calibrator runs it while acquiring: with a RotationGridCache that already
+// holds the window's first N − 1 frames (the previous frame's grid), so only the new frame is
+// scored over the lattice.
+void BM_RotationGridCachedNewFrame(benchmark::State& state) {
+  if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
+  const CalibrationState initial = KittiCalibration();
+  const std::vector<const CalibrationFrame*> frames = FirstFrames(state.range(0));
+  RotationGridCache previous;
+  {
+    WindowScorer scorer(std::vector<const CalibrationFrame*>(frames.begin(), frames.end() - 1),
+                        ScoreOptions());
+    RotationGridSearch(&scorer, initial, initial, AdaptiveGridSearchOptions(), 3.0, 0.5, -1,
+                       &previous);
+  }
+  for (auto _ : state) {
+    state.PauseTiming();
+    RotationGridCache cache = previous;
+    state.ResumeTiming();
+    WindowScorer scorer(frames, ScoreOptions());
+    benchmark::DoNotOptimize(RotationGridSearch(&scorer, initial, initial,
+                                                AdaptiveGridSearchOptions(), 3.0, 0.5, -1, &cache));
+  }
+  state.SetLabel("2197 rotations over " + std::to_string(state.range(0)) + " frames, " +
+                 std::to_string(state.range(0) - 1) + " of them cached");
+}
+BENCHMARK(BM_RotationGridCachedNewFrame)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
+
 // The health score (method.md §7): 728 neighbours of the estimate scored over N frames; an
 // online update measures it before and after, and every 6-DoF search step scores as many.
 void BM_HealthScore(benchmark::State& state) {
