@@ -3,6 +3,7 @@
 // checked on it, so this stays a few seconds long.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -165,38 +166,70 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   EXPECT_GT(grid.score, scorer.Evaluate(start_true_delta, -1).score);
 
   // The grid's cache (the calibrator's while acquiring): on a window growing one frame at a time
-  // and then sliding, the cached grid gives the uncached grid's result bit for bit and scores
-  // each frame once; another translation scores them all again.
+  // and then sliding, the cached grid finds the best lattice point of a brute-force pass with
+  // WindowScorer::Evaluate (the sum over frames up to rounding), gives the uncached grid's result
+  // bit for bit and scores each frame once; another translation or δ scores them all again; two
+  // different frames under the same key are both scored.
   {
+    // The best lattice point by brute force on the whole-window score.
+    auto brute_force_best = [&](WindowScorer* scorer, const CalibrationState& centre) {
+      double best = -std::numeric_limits<double>::infinity();
+      for (int a = -6; a <= 6; ++a) {
+        for (int b = -6; b <= 6; ++b) {
+          for (int c = -6; c <= 6; ++c) {
+            best = std::max(
+                best, scorer
+                          ->Evaluate(Step(centre, Eigen::Vector3d(a, b, c) * 0.5 * M_PI / 180.0,
+                                          Eigen::Vector3d::Zero(), 0.0),
+                                     -1)
+                          .score);
+          }
+        }
+      }
+      return best;
+    };
     RotationGridCache cache;
-    auto grid_on = [&](size_t first, size_t count, const CalibrationState& centre,
-                       RotationGridCache* with) {
-      WindowScorer part(std::vector<const CalibrationFrame*>(window.begin() + first,
-                                                             window.begin() + first + count),
-                        ScoreOptions());
-      return RotationGridSearch(&part, centre, start_true_delta, AdaptiveGridSearchOptions(), 3.0,
-                                0.5, -1, with);
+    auto grid_on = [&](const std::vector<const CalibrationFrame*>& frames_in,
+                       const CalibrationState& centre, RotationGridCache* with, double* brute) {
+      WindowScorer part(frames_in, ScoreOptions());
+      const RotationGridResult grid = RotationGridSearch(
+          &part, centre, start_true_delta, AdaptiveGridSearchOptions(), 3.0, 0.5, -1, with);
+      if (brute != nullptr) *brute = brute_force_best(&part, centre);
+      return grid;
+    };
+    auto frames_of = [&](size_t first, size_t count) {
+      return std::vector<const CalibrationFrame*>(window.begin() + first,
+                                                  window.begin() + first + count);
     };
     const std::pair<size_t, size_t> windows[] = {{0, 1}, {0, 2}, {0, 3}, {1, 3}};
     const int scored_after[] = {1, 2, 3, 4};
     for (int k = 0; k < 4; ++k) {
       const auto [first, count] = windows[k];
-      const RotationGridResult cached = grid_on(first, count, start_true_delta, &cache);
-      const RotationGridResult fresh = grid_on(first, count, start_true_delta, nullptr);
+      double brute = 0;
+      const RotationGridResult cached =
+          grid_on(frames_of(first, count), start_true_delta, &cache, &brute);
+      const RotationGridResult fresh =
+          grid_on(frames_of(first, count), start_true_delta, nullptr, nullptr);
+      EXPECT_NEAR(cached.score, brute, 1e-9 * brute) << k;
       EXPECT_EQ(cached.score, fresh.score) << k;
       EXPECT_EQ(cached.state.T_camera_lidar.matrix(), fresh.state.T_camera_lidar.matrix()) << k;
       EXPECT_EQ(cached.evaluations, 13 * 13 * 13);
       EXPECT_EQ(cache.frames_scored(), scored_after[k]) << k;
-      // The sum of per-frame scores is the window's score.
-      WindowScorer part(std::vector<const CalibrationFrame*>(window.begin() + first,
-                                                             window.begin() + first + count),
-                        ScoreOptions());
-      EXPECT_NEAR(cached.score, part.Evaluate(cached.state, -1).score, 1e-9 * cached.score);
     }
-    const CalibrationState moved =
-        Step(start_true_delta, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.01, 0, 0), 0.0);
-    grid_on(1, 3, moved, &cache);
+    grid_on(frames_of(1, 3),
+            Step(start_true_delta, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.01, 0, 0), 0.0),
+            &cache, nullptr);
     EXPECT_EQ(cache.frames_scored(), 4 + 3);
+    grid_on(frames_of(1, 3),
+            Step(start_true_delta, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.01, 0, 0), 0.002),
+            &cache, nullptr);
+    EXPECT_EQ(cache.frames_scored(), 7 + 3);
+    // A frame with frame 0's key (index, stamp, size) but other points.
+    CalibrationFrame twin = *window[0];
+    for (Eigen::Vector3d& p : twin.points_lidar) p.z() += 0.3;
+    double brute = 0;
+    const RotationGridResult mixed = grid_on({window[0], &twin}, start_true_delta, &cache, &brute);
+    EXPECT_NEAR(mixed.score, brute, 1e-9 * brute);
   }
 
   // Refinement over eight frames from a small error: closer to the truth, with a covariance.

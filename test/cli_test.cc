@@ -553,7 +553,9 @@ TEST(Cli, KittiSingleFrameEstimatesOnlyWithASingleFrameWindow) {
   EXPECT_FALSE(std::filesystem::exists(single + "/calib_velo_to_cam.txt"));
   const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(single + "/result.json"));
   EXPECT_GT(result["initial_error"]["rotation_deg"].get<double>(), 3.4);
-  EXPECT_LT(result["agreement_with_drive_calibration"]["rotation_deg"].get<double>(), 1.0)
+  // At least halfway back (measured 0.52 deg from 3.46).
+  EXPECT_LT(result["agreement_with_drive_calibration"]["rotation_deg"].get<double>(),
+            0.5 * result["initial_error"]["rotation_deg"].get<double>())
       << one.output;
 }
 

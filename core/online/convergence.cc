@@ -104,18 +104,18 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   } else if (last.points < options.min_points) {
     verdict.reason = "not converged: no usable features (" + std::to_string(last.points) +
                      " LiDAR edge points in the image)";
+  } else if (calibrator.options().wait_for_full_window &&
+             verdict.used_frames < calibrator.options().window_frames) {
+    // Not even one update: say so, or the start would read as an estimate.
+    verdict.reason = "not converged: " + std::to_string(verdict.used_frames) +
+                     " usable frame(s), fewer than the search window's " +
+                     std::to_string(calibrator.options().window_frames) +
+                     ", so the estimate was never updated (a search window of 1 frame estimates "
+                     "from a single frame)";
   } else if (verdict.used_frames < options.min_frames) {
     verdict.reason = "not converged: " + std::to_string(verdict.used_frames) +
                      " usable frame(s) cannot show that the estimate has settled (" +
                      std::to_string(options.min_frames) + " needed)";
-    const OnlineCalibratorOptions& in_effect = calibrator.options();
-    if (in_effect.wait_for_full_window && verdict.used_frames < in_effect.window_frames) {
-      // Not even one update: say so, or the start would read as an estimate.
-      verdict.reason += "; fewer frames than the search window's " +
-                        std::to_string(in_effect.window_frames) +
-                        ", so the estimate was never updated (a search window of 1 frame "
-                        "estimates from a single frame)";
-    }
   } else if (calibrator.acquiring()) {
     verdict.reason =
         "not converged: still acquiring (the rotation grid around the initial "

@@ -77,30 +77,26 @@ const std::vector<Eigen::Vector3d>& WindowScorer::Moved(size_t frame, double tim
   return moved_[frame];
 }
 
-const cv::Mat& WindowScorer::LevelMap(const CalibrationFrame& cf, int kind, int level) {
-  const int maps = static_cast<int>(cf.score_maps[kind].size());
-  const int l = level < 0 ? maps + level : level;
-  CHECK(l >= 0 && l < maps) << "score level " << level << " of " << maps;
-  return cf.score_maps[kind][l];
-}
-
-ScoreValue WindowScorer::Evaluate(const CalibrationState& state, int level) {
+ScoreValue WindowScorer::EvaluateLevel(const CalibrationState& state, int level, size_t begin,
+                                       size_t end) {
   return EvaluateOn(
       state,
       [level](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
-        return LevelMap(cf, kind, level);
+        const int maps = static_cast<int>(cf.score_maps[kind].size());
+        const int l = level < 0 ? maps + level : level;
+        CHECK(l >= 0 && l < maps) << "score level " << level << " of " << maps;
+        return cf.score_maps[kind][l];
       },
-      0, frames_.size());
+      begin, end);
+}
+
+ScoreValue WindowScorer::Evaluate(const CalibrationState& state, int level) {
+  return EvaluateLevel(state, level, 0, frames_.size());
 }
 
 ScoreValue WindowScorer::EvaluateFrame(size_t f, const CalibrationState& state, int level) {
   CHECK_LT(f, frames_.size());
-  return EvaluateOn(
-      state,
-      [level](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
-        return LevelMap(cf, kind, level);
-      },
-      f, f + 1);
+  return EvaluateLevel(state, level, f, f + 1);
 }
 
 double WindowScorer::GrayRate(const CalibrationState& state) {

@@ -52,8 +52,8 @@ class WindowScorer {
   template <typename MapOf>
   ScoreValue EvaluateOn(const CalibrationState& state, const MapOf& map_of, size_t begin,
                         size_t end);
-  // The map of `level` (negative counts from the finest: −1) for one kind of edge.
-  static const cv::Mat& LevelMap(const CalibrationFrame& cf, int kind, int level);
+  // Evaluate() over frames [begin, end).
+  ScoreValue EvaluateLevel(const CalibrationState& state, int level, size_t begin, size_t end);
 
   std::vector<const CalibrationFrame*> frames_;
   ScoreOptions options_;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 
 namespace stcalib {
 namespace {
@@ -163,10 +164,9 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
 }
 
 bool RotationGridCache::Lattice::operator==(const Lattice& o) const {
-  return center == o.center && anchor == o.anchor &&
-         center_time_offset_s == o.center_time_offset_s &&
-         anchor_time_offset_s == o.anchor_time_offset_s && half_range_deg == o.half_range_deg &&
-         step_deg == o.step_deg && level == o.level && horizontal_weight == o.horizontal_weight &&
+  return center == o.center && center_time_offset_s == o.center_time_offset_s &&
+         half_range_deg == o.half_range_deg && step_deg == o.step_deg && level == o.level &&
+         horizontal_weight == o.horizontal_weight &&
          max_points_per_frame == o.max_points_per_frame && in_bounds == o.in_bounds;
 }
 
@@ -193,9 +193,7 @@ RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationSta
   RotationGridCache local;
   if (cache == nullptr) cache = &local;
   RotationGridCache::Lattice lattice{center.T_camera_lidar.matrix(),
-                                     anchor.T_camera_lidar.matrix(),
                                      center.time_offset_s,
-                                     anchor.time_offset_s,
                                      half_range_deg,
                                      step_deg,
                                      level,
@@ -209,22 +207,28 @@ RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationSta
   }
   const std::vector<uint8_t>& mask = cache->lattice_.in_bounds;
   // Per-frame scores, from the cache or computed; frames no longer in the window forgotten.
+  auto score_frame = [&](size_t f) {
+    std::vector<double> scores(points.size(), 0.0);
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (mask[i]) scores[i] = scorer->EvaluateFrame(f, points[i], level).score;
+    }
+    ++cache->frames_scored_;
+    return scores;
+  };
   std::map<RotationGridCache::FrameKey, std::vector<double>> kept;
+  std::deque<std::vector<double>> duplicates;  // frames whose key an earlier one took
   std::vector<const std::vector<double>*> frame_scores;
   for (size_t f = 0; f < scorer->num_frames(); ++f) {
     const CalibrationFrame& frame = scorer->frame(f);
     const RotationGridCache::FrameKey key{frame.index, frame.camera_time_s, frame.size()};
-    auto it = cache->scores_.find(key);
-    std::vector<double> scores;
-    if (it != cache->scores_.end()) {
-      scores = std::move(it->second);
-    } else {
-      scores.assign(points.size(), 0.0);
-      for (size_t i = 0; i < points.size(); ++i) {
-        if (mask[i]) scores[i] = scorer->EvaluateFrame(f, points[i], level).score;
-      }
-      ++cache->frames_scored_;
+    if (kept.count(key) > 0) {
+      duplicates.push_back(score_frame(f));
+      frame_scores.push_back(&duplicates.back());
+      continue;
     }
+    auto it = cache->scores_.find(key);
+    std::vector<double> scores =
+        it != cache->scores_.end() ? std::move(it->second) : score_frame(f);
     frame_scores.push_back(&kept.emplace(key, std::move(scores)).first->second);
   }
   RotationGridResult result;

@@ -69,13 +69,17 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
 struct RotationGridResult {
   CalibrationState state;  ///< the best grid point (`center` when nothing scored better)
   double score = 0;        ///< its score on `level`
-  int evaluations = 0;
+  int evaluations = 0;     ///< lattice points compared (scored now or taken from the cache)
 };
+
 // Per-frame scores of RotationGridSearch's lattice, kept from one call to the next. While
 // acquiring, the calibrator runs the grid on a window that grows by one frame per call; as long
-// as the lattice (centre, anchor, range, step, level, bounds) and the score options stay the
-// same, a frame scored by an earlier call is not scored again. A frame is known by its index,
-// camera stamp and number of points; frames that left the window are forgotten.
+// as the lattice (centre, range, step, level, which points lie within the bounds) and the score
+// options stay the same, a frame scored by an earlier call is not scored again. A frame is known
+// by its index, camera stamp and number of points, so a caller must not change a frame's content
+// under the same key (the calibrator's frames are pruned once, when they arrive, and then const).
+// Two frames with the same key in one window are each scored, never shared. Frames that left the
+// window are forgotten.
 class RotationGridCache {
  public:
   // Frames scored over the whole lattice since construction (the work the cache did not save).
@@ -96,8 +100,8 @@ class RotationGridCache {
   };
   // What the per-frame scores depend on besides the frame; compared exactly.
   struct Lattice {
-    Eigen::Matrix4d center, anchor;
-    double center_time_offset_s, anchor_time_offset_s, half_range_deg, step_deg;
+    Eigen::Matrix4d center;
+    double center_time_offset_s, half_range_deg, step_deg;
     int level;
     double horizontal_weight;
     int max_points_per_frame;
