@@ -273,6 +273,16 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
       EXPECT_TRUE(calibrator.state().T_camera_lidar.isApprox(before.T_camera_lidar));
     }
   }
+  // The acquisition's grid ran with the calibrator's cache: some frames were scored, fewer than
+  // a grid over the whole window on every frame after the window filled would score.
+  int uncached_bound = 0;
+  for (int k = online_options.window_frames - 1; k < static_cast<int>(frames.size()); ++k) {
+    uncached_bound += std::min(k + 1, online_options.refine_frames);
+  }
+  std::printf("grid cache: %d frames scored (at most %d without it)\n",
+              calibrator.grid_cache().frames_scored(), uncached_bound);
+  EXPECT_GT(calibrator.grid_cache().frames_scored(), 0);
+  EXPECT_LT(calibrator.grid_cache().frames_scored(), uncached_bound);
   const CalibrationError online_error = ComputeCalibrationError(calibrator.state(), truth);
   std::printf("online after %zu frames: %s, health %.2f\n", frames.size(),
               ToString(online_error).c_str(), last.health);

@@ -117,6 +117,8 @@ class OnlineCalibrator {
   const CalibrationState& state() const { return state_; }
   // The options in effect (the shared settings copied into score, search and refine).
   const OnlineCalibratorOptions& options() const { return options_; }
+  // The rotation grid's per-frame scores (acquiring or lost), kept across frames.
+  const RotationGridCache& grid_cache() const { return grid_cache_; }
   // Still acquiring (OnlineCalibratorOptions::acquire_with_grid with a grid): the rotation grid
   // has not yet agreed with the estimate on a full refinement window.
   bool acquiring() const {
