@@ -163,10 +163,6 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
                                      std::to_string(last) + " out of range (" +
                                      std::to_string(drive.NumFrames()) + " frames)"));
   }
-  std::unique_ptr<DriveFrameSource> source;
-  status = DriveFrameSource::Create(&drive, job.source, &source);
-  if (!status.ok()) return ReportError(kCommand, status);
-
   // Reference: simulated ground truth when present, else the drive's own calibration.
   status = ReadGroundTruth(drive, &outcome->has_truth, &outcome->reference_state);
   if (!status.ok()) return ReportError(kCommand, status);
@@ -185,6 +181,12 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   initial.time_offset_s = job.perturb_time_s;
   outcome->initial = initial;
   outcome->initial_error = ComputeCalibrationError(initial, outcome->reference_state);
+  // The dynamic filter judges the camera's view as the starting calibration places it.
+  FrameSourceOptions source_options = job.source;
+  source_options.view_T_camera_lidar = initial.T_camera_lidar;
+  std::unique_ptr<DriveFrameSource> source;
+  status = DriveFrameSource::Create(&drive, source_options, &source);
+  if (!status.ok()) return ReportError(kCommand, status);
 
   std::error_code ec;
   fs::create_directories(job.out_dir, ec);

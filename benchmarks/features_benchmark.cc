@@ -11,6 +11,7 @@
 #include "core/features/lidar_frame.h"
 #include "core/io/drive.h"
 #include "core/motion/drive_motion.h"
+#include "core/online/frame_source.h"
 #include "core/pcl/registration.h"
 
 namespace stcalib {
@@ -72,6 +73,15 @@ void BM_ImageFeaturesWithPyramid(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(ExtractImageFeatures(Kitti().image, options));
 }
 BENCHMARK(BM_ImageFeaturesWithPyramid)->Unit(benchmark::kMillisecond);
+
+// As the online frame source asks for them (DriveFrameSource::Load): split orientation with
+// its own texture-suppressed pyramid, which is what every calibration frame pays.
+void BM_ImageFeaturesAsOnline(benchmark::State& state) {
+  REQUIRE_KITTI(state);
+  const ImageFeatureOptions options = FrameSourceOptions().ImageOptions();
+  for (auto _ : state) benchmark::DoNotOptimize(ExtractImageFeatures(Kitti().image, options));
+}
+BENCHMARK(BM_ImageFeaturesAsOnline)->Unit(benchmark::kMillisecond);
 
 // The rows LiDAR points can reach (below the top beam at +2°, with margin), as the online path
 // uses them: rows 110..374 of the 375.

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -32,6 +33,43 @@ std::shared_ptr<CalibrationFrame> BareFrame(int index, double time_s) {
     frame->score_maps[kind].push_back(frame->gray_map[kind]);
   }
   return frame;
+}
+
+// The dynamic filter's window holds the camera's horizontal field of view: KITTI's camera looks
+// along the LiDAR's x axis, and its half field of view is atan(max(cx, W − cx)/fx) = 41.2°. The
+// same camera turned to look along the LiDAR's y axis moves the window by 90°.
+TEST(FrameSource, CameraAzimuthWindowHoldsTheFieldOfView) {
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  const CameraCalibration& camera = drive.camera;
+  const double fx = camera.P_rect_02(0, 0), cx = camera.P_rect_02(0, 2);
+  const double half_fov_deg = std::atan(std::max(cx, camera.image_width - cx) / fx) * 180.0 / M_PI;
+  EXPECT_NEAR(half_fov_deg, 41.2, 0.1);
+  const Eigen::Vector2d ahead = CameraAzimuthWindowDeg(
+      camera, camera.image_width, camera.image_height, drive.T_camera_lidar, 20);
+  EXPECT_NEAR(ahead.x(), 0.0, 1.0);
+  EXPECT_NEAR(ahead.y(), half_fov_deg + 20, 1.0);
+  const Rigid3d sideways =
+      drive.T_camera_lidar *
+      MakeRigid(ExpSO3(Eigen::Vector3d(0, 0, -M_PI / 2)), Eigen::Vector3d::Zero());
+  const Eigen::Vector2d side =
+      CameraAzimuthWindowDeg(camera, camera.image_width, camera.image_height, sideways, 20);
+  EXPECT_NEAR(side.x(), 90.0, 1.0);
+  EXPECT_NEAR(side.y(), ahead.y(), 1e-6);
+  // Looking straight up: no azimuth window holds the view, so the whole sweep is judged.
+  const Rigid3d up = drive.T_camera_lidar *
+                     MakeRigid(ExpSO3(Eigen::Vector3d(0, M_PI / 2, 0)), Eigen::Vector3d::Zero());
+  EXPECT_EQ(CameraAzimuthWindowDeg(camera, camera.image_width, camera.image_height, up, 20).y(),
+            0.0);
+  // The frame source applies it; a negative margin judges the whole sweep.
+  std::unique_ptr<DriveFrameSource> source;
+  ASSERT_TRUE(DriveFrameSource::Create(&drive, FrameSourceOptions(), &source).ok());
+  EXPECT_NEAR(source->dynamic_options().roi_half_angle_deg, ahead.y(), 1e-9);
+  FrameSourceOptions whole;
+  whole.view_margin_deg = -1;
+  ASSERT_TRUE(DriveFrameSource::Create(&drive, whole, &source).ok());
+  EXPECT_EQ(source->dynamic_options().roi_half_angle_deg, 0.0);
 }
 
 // Fault injection at the calibrator itself: frames that go back in time, repeat a stamp, carry

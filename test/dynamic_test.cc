@@ -188,6 +188,64 @@ TEST(DynamicFilter, RemovesMovingObjectsAndKeepsStructure) {
   EXPECT_LE(static_rate, 0.03);
 }
 
+// The camera-view window only saves work: every cluster that reaches into it is judged exactly
+// as with the whole sweep (its points keep their verdicts, inside the window and out), and no
+// cluster wholly outside it is removed. Checked with the window ahead and turned to the side.
+TEST(DynamicFilter, ViewWindowJudgesItsClustersExactlyAsTheWholeSweep) {
+  SimulatorOptions options;
+  options.seed = 2;
+  options.frames = 20;
+  const Simulator s(options);
+  const OxtsMotion motion(s);
+  const LidarFeatureOptions feature_options;
+  int in_window_removed = 0, outside_removed_whole = 0;
+  for (int frame : {4, 15}) {
+    const double t = s.LidarMidTime(frame);
+    std::vector<LidarFrameFeatures> bases;
+    for (int gap : {1, 3}) {
+      bases.push_back(ComputeLidarSweepBase(s.SimulateSweep(frame - gap).scan,
+                                            s.LidarMidTime(frame - gap), s.SweepDuration(), motion,
+                                            feature_options));
+    }
+    std::vector<ReferenceSweep> references(2);
+    for (int k = 0; k < 2; ++k) {
+      references[k].points = &bases[k].deskewed;
+      references[k].ground = &bases[k].ground;
+      references[k].T_current_reference = RelativeLidarPose(motion, t, bases[k].stamp_s);
+      references[k].check_visibility = k == 1;
+    }
+    const LidarFrameFeatures current = ComputeLidarSweepBase(
+        s.SimulateSweep(frame).scan, t, s.SweepDuration(), motion, feature_options);
+    const DynamicFilterResult whole =
+        DetectDynamicPoints(current.deskewed, current.ground, references, feature_options.dynamic);
+    for (double center_deg : {0.0, 90.0}) {
+      DynamicFilterOptions windowed = feature_options.dynamic;
+      windowed.roi_center_azimuth_deg = center_deg;
+      windowed.roi_half_angle_deg = 45;
+      const DynamicFilterResult view =
+          DetectDynamicPoints(current.deskewed, current.ground, references, windowed);
+      ASSERT_EQ(view.dynamic.size(), whole.dynamic.size());
+      for (size_t i = 0; i < whole.dynamic.size(); ++i) {
+        const Eigen::Vector3d& p = current.deskewed[i];
+        const double azimuth_deg = std::atan2(p.y(), p.x()) * 180.0 / M_PI;
+        const bool inside = std::abs(std::remainder(azimuth_deg - center_deg, 360.0)) <= 45.0;
+        if (inside) {
+          ASSERT_EQ(view.dynamic[i], whole.dynamic[i]) << "frame " << frame << " point " << i;
+          in_window_removed += view.dynamic[i];
+        } else {
+          // Outside: removed only with a cluster that reaches in, and then as with the whole.
+          ASSERT_LE(view.dynamic[i], whole.dynamic[i]) << "frame " << frame << " point " << i;
+          outside_removed_whole += whole.dynamic[i] && !view.dynamic[i];
+        }
+      }
+    }
+  }
+  std::printf("removed inside the windows: %d points; outside, only by the whole sweep: %d\n",
+              in_window_removed, outside_removed_whole);
+  EXPECT_GT(in_window_removed, 50);      // the windows hold moving objects
+  EXPECT_GT(outside_removed_whole, 50);  // and the window did leave clusters unjudged
+}
+
 TEST(LocalMap, KittiMapOfThreeSweepsWithOxtsAndNdt) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;

@@ -24,27 +24,79 @@ Status DynamicFilterOptions::Validate() const {
 
 namespace {
 
-// Range limit and, when set, the azimuth window |atan2(y, x)| ≤ half angle, tested without
-// trigonometry: the angle to the x axis is ≤ half ⇔ x ≥ |(x, y)|·cos(half).
-class Region {
+// The azimuth window |azimuth − centre| ≤ half angle, tested without trigonometry: in a frame
+// whose x axis points at the centre, the angle to x is ≤ half ⇔ x ≥ |(x, y)|·cos(half).
+class AzimuthWindow {
  public:
-  Region(const DynamicFilterOptions& o, double extra_m, double extra_deg)
-      : max_r2_((o.max_range_m + extra_m) * (o.max_range_m + extra_m)),
-        all_azimuths_(o.roi_half_angle_deg <= 0 || o.roi_half_angle_deg + extra_deg >= 180),
-        cos_half_(std::cos((o.roi_half_angle_deg + extra_deg) * M_PI / 180.0)) {}
+  AzimuthWindow(double center_deg, double half_deg)
+      : all_(half_deg <= 0 || half_deg >= 180),
+        cos_center_(std::cos(center_deg * M_PI / 180.0)),
+        sin_center_(std::sin(center_deg * M_PI / 180.0)),
+        cos_half_(std::cos(half_deg * M_PI / 180.0)) {}
+  bool all() const { return all_; }
   bool Contains(const Eigen::Vector3d& p) const {
-    if (p.squaredNorm() > max_r2_) return false;
-    if (all_azimuths_) return true;
-    if (cos_half_ >= 0) {
-      return p.x() >= 0 && p.x() * p.x() >= (p.x() * p.x() + p.y() * p.y()) * cos_half_ * cos_half_;
-    }
-    return p.x() >= 0 || p.x() * p.x() <= (p.x() * p.x() + p.y() * p.y()) * cos_half_ * cos_half_;
+    if (all_) return true;
+    const double x = cos_center_ * p.x() + sin_center_ * p.y();
+    const double y = -sin_center_ * p.x() + cos_center_ * p.y();
+    if (cos_half_ >= 0) return x >= 0 && x * x >= (x * x + y * y) * cos_half_ * cos_half_;
+    return x >= 0 || x * x <= (x * x + y * y) * cos_half_ * cos_half_;
   }
 
  private:
-  double max_r2_;
-  bool all_azimuths_;
-  double cos_half_;
+  bool all_;
+  double cos_center_, sin_center_, cos_half_;
+};
+
+// Cells of a horizontal grid around the sensor that lie within `reach_m` of a marked point:
+// a reference point outside them cannot be any marked query's neighbour within τ.
+class ReachGrid {
+ public:
+  ReachGrid(double half_extent_m, double cell_m)
+      : cell_m_(cell_m),
+        half_(static_cast<int>(std::ceil(half_extent_m / cell_m))),
+        side_(2 * half_ + 1),
+        marked_(static_cast<size_t>(side_) * side_, 0) {}
+  void Mark(const Eigen::Vector3d& p) {
+    const int i = Index(p);
+    if (i < 0) {
+      outside_ = true;
+    } else {
+      marked_[i] = 1;
+    }
+  }
+  // Marks the 8 neighbours of every marked cell (cells are at least the reach wide).
+  void Dilate() {
+    std::vector<uint8_t> grown = marked_;
+    for (int y = 0; y < side_; ++y) {
+      for (int x = 0; x < side_; ++x) {
+        if (!marked_[y * side_ + x]) continue;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx >= 0 && xx < side_ && yy >= 0 && yy < side_) grown[yy * side_ + xx] = 1;
+          }
+        }
+      }
+    }
+    marked_.swap(grown);
+  }
+  // Points off the grid are kept whenever a marked point was off it too.
+  bool Reaches(const Eigen::Vector3d& p) const {
+    const int i = Index(p);
+    return i < 0 ? outside_ : marked_[i] != 0;
+  }
+
+ private:
+  int Index(const Eigen::Vector3d& p) const {
+    const int x = static_cast<int>(std::floor(p.x() / cell_m_)) + half_;
+    const int y = static_cast<int>(std::floor(p.y() / cell_m_)) + half_;
+    if (x < 0 || x >= side_ || y < 0 || y >= side_) return -1;
+    return y * side_ + x;
+  }
+  double cell_m_;
+  int half_, side_;
+  std::vector<uint8_t> marked_;
+  bool outside_ = false;
 };
 
 int Find(std::vector<int>& parent, int i) {
@@ -55,10 +107,11 @@ int Find(std::vector<int>& parent, int i) {
 // Spherical range image of a sweep: the nearest return per (azimuth, elevation) cell.
 class RangeImage {
  public:
-  RangeImage(const std::vector<Eigen::Vector3d>& points, const Region& region)
+  RangeImage(const std::vector<Eigen::Vector3d>& points, double max_range_m)
       : range_(kAz * kEl, kEmpty) {
+    const double max_r2 = max_range_m * max_range_m;
     for (const auto& p : points) {
-      if (!region.Contains(p)) continue;
+      if (p.squaredNorm() > max_r2) continue;
       const int c = Cell(p);
       if (c >= 0) range_[c] = std::min(range_[c], static_cast<float>(p.norm()));
     }
@@ -99,35 +152,46 @@ int64_t VoxelKey(const Eigen::Vector3d& p, double cell) {
   return (x & 0x1FFFFF) | ((y & 0x1FFFFF) << 21) | ((z & 0x1FFFFF) << 42);
 }
 
-// Flags the selected current points that `reference` cannot explain. `representative[k]` is the
-// selected point whose query stands for point k (same query voxel).
+// τ(r), widened by the reference voxel's half diagonal [m].
+double Tau(const DynamicFilterOptions& options, double range_m) {
+  return options.tau0_m + options.tau_per_range * range_m + 0.87 * options.reference_voxel_m;
+}
+
+// Flags the selected current points with `queried` set that `reference` cannot explain.
+// `representative[k]` is the selected point whose query stands for point k (same query voxel).
+// `reach`, when given, holds every place within τ of a queried point: reference points outside
+// it are left out of the tree, which cannot change a verdict (a neighbour within τ lies inside).
 void FlagAgainst(const std::vector<Eigen::Vector3d>& current, const std::vector<int>& selected,
-                 const std::vector<int>& representative, const ReferenceSweep& reference,
+                 const std::vector<int>& representative, const std::vector<uint8_t>& queried,
+                 const ReferenceSweep& reference, const ReachGrid* reach,
                  const DynamicFilterOptions& options, std::vector<uint8_t>* flagged) {
   const std::vector<Eigen::Vector3d>& own = *reference.points;
   std::vector<Eigen::Vector3d> moved;
   moved.reserve(own.size() / 2);
   std::unordered_map<int64_t, char> occupied;
-  const Region region(options, 5.0, 10.0);
+  const double max_r2 = (options.max_range_m + 5.0) * (options.max_range_m + 5.0);
   for (size_t i = 0; i < own.size(); ++i) {
     if (reference.ground != nullptr && !reference.ground->empty() && (*reference.ground)[i])
       continue;
     const Eigen::Vector3d p = reference.T_current_reference * own[i];
-    if (!region.Contains(p)) continue;
+    if (p.squaredNorm() > max_r2) continue;
     if (options.reference_voxel_m > 0 &&
         !occupied.emplace(VoxelKey(p, options.reference_voxel_m), 1).second) {
       continue;
     }
+    if (reach != nullptr && !reach->Reaches(p)) continue;
     moved.push_back(p);
   }
   if (moved.empty()) return;
   const PointKdTree tree(moved);
   std::unique_ptr<RangeImage> view;
-  if (reference.check_visibility) view = std::make_unique<RangeImage>(own, region);
+  if (reference.check_visibility) {
+    view = std::make_unique<RangeImage>(own, options.max_range_m + 5.0);
+  }
   const Rigid3d T_reference_current = reference.T_current_reference.inverse();
   std::vector<int8_t> verdict(selected.size(), -1);  // per representative: 0 static, 1 flagged
   for (size_t k = 0; k < selected.size(); ++k) {
-    if ((*flagged)[k]) continue;
+    if ((*flagged)[k] || !queried[k]) continue;
     const int rep = representative[k];
     if (verdict[rep] < 0) {
       verdict[rep] = 0;
@@ -135,11 +199,7 @@ void FlagAgainst(const std::vector<Eigen::Vector3d>& current, const std::vector<
       int nearest;
       double distance;
       tree.Nearest(p, &nearest, &distance);
-      // τ(r), widened by the reference voxel's half diagonal.
-      if (distance >
-          options.tau0_m + options.tau_per_range * p.norm() + 0.87 * options.reference_voxel_m) {
-        verdict[rep] = 1;
-      }
+      if (distance > Tau(options, p.norm())) verdict[rep] = 1;
     }
     if (verdict[rep] == 0) continue;
     const Eigen::Vector3d& p = current[selected[k]];
@@ -168,30 +228,13 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
     return result;
   }
   std::vector<int> selected;
-  const Region region(options, 0.0, 0.0);
+  const double max_r2 = options.max_range_m * options.max_range_m;
   for (size_t i = 0; i < current.size(); ++i) {
-    if ((current_ground.empty() || !current_ground[i]) && region.Contains(current[i])) {
+    if ((current_ground.empty() || !current_ground[i]) && current[i].squaredNorm() <= max_r2) {
       selected.push_back(static_cast<int>(i));
     }
   }
   if (selected.empty()) return result;
-  // Points sharing a query voxel share one nearest-neighbour query.
-  std::vector<int> representative(selected.size());
-  {
-    std::unordered_map<int64_t, int> first;
-    first.reserve(selected.size());
-    for (size_t k = 0; k < selected.size(); ++k) {
-      const double cell = options.query_voxel_m > 0 ? options.query_voxel_m : 1e-6;
-      representative[k] =
-          first.emplace(VoxelKey(current[selected[k]], cell), static_cast<int>(k)).first->second;
-    }
-  }
-  std::vector<uint8_t> flagged(selected.size(), 0);
-  for (const ReferenceSweep& reference : references) {
-    CHECK(reference.points != nullptr);
-    FlagAgainst(current, selected, representative, reference, options, &flagged);
-  }
-  for (uint8_t f : flagged) result.flagged_points += f;
 
   // Euclidean clustering on a voxel grid: occupied voxels touching (26-neighbourhood) join.
   const double cell = options.cluster_tolerance_m;
@@ -227,32 +270,70 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
       }
     }
   }
+  // Per cluster (indexed by its root voxel): size, extent and whether it reaches the view.
   struct ClusterStats {
     int points = 0, flagged = 0;
+    bool in_view = false;
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e18), hi = Eigen::Vector3d::Constant(-1e18);
   };
-  std::unordered_map<int, ClusterStats> clusters;
+  std::vector<ClusterStats> clusters(voxels.size());
   std::vector<int> point_cluster(selected.size());
+  const AzimuthWindow view(options.roi_center_azimuth_deg, options.roi_half_angle_deg);
   for (size_t k = 0; k < selected.size(); ++k) {
     const int c = Find(parent, point_voxel[k]);
     point_cluster[k] = c;
     ClusterStats& s = clusters[c];
-    ++s.points;
-    s.flagged += flagged[k];
-    s.lo = s.lo.cwiseMin(current[selected[k]]);
-    s.hi = s.hi.cwiseMax(current[selected[k]]);
+    const Eigen::Vector3d& p = current[selected[k]];
+    if (s.points++ == 0) ++result.clusters;
+    s.lo = s.lo.cwiseMin(p);
+    s.hi = s.hi.cwiseMax(p);
+    s.in_view = s.in_view || view.Contains(p);
   }
-  result.clusters = static_cast<int>(clusters.size());
-  std::unordered_map<int, bool> is_dynamic;
-  for (const auto& [id, s] : clusters) {
-    const bool dynamic = s.flagged >= options.min_flagged_points &&
-                         s.flagged >= options.min_flagged_fraction * s.points &&
-                         (s.hi - s.lo).head<2>().maxCoeff() <= options.max_cluster_extent_m;
-    is_dynamic[id] = dynamic;
-    result.dynamic_clusters += dynamic;
+  // Only a cluster that could be removed is worth its queries: in the view, small enough to
+  // move, with enough points to reach min_flagged_points.
+  auto judged = [&](const ClusterStats& s) {
+    return s.in_view && s.points >= options.min_flagged_points &&
+           (s.hi - s.lo).head<2>().maxCoeff() <= options.max_cluster_extent_m;
+  };
+  std::vector<uint8_t> queried(selected.size(), 0);
+  for (size_t k = 0; k < selected.size(); ++k) queried[k] = judged(clusters[point_cluster[k]]);
+
+  // Points sharing a query voxel share one nearest-neighbour query.
+  std::vector<int> representative(selected.size());
+  {
+    std::unordered_map<int64_t, int> first;
+    first.reserve(selected.size());
+    for (size_t k = 0; k < selected.size(); ++k) {
+      const double query_cell = options.query_voxel_m > 0 ? options.query_voxel_m : 1e-6;
+      representative[k] =
+          first.emplace(VoxelKey(current[selected[k]], query_cell), static_cast<int>(k))
+              .first->second;
+    }
+  }
+  // Where the queries can find a neighbour within τ: cells at least τ_max wide, dilated by one.
+  const double tau_max = Tau(options, options.max_range_m);
+  ReachGrid reach(options.max_range_m + 2 * tau_max, std::max(tau_max, 0.5));
+  for (size_t k = 0; k < selected.size(); ++k) {
+    if (queried[k]) reach.Mark(current[selected[representative[k]]]);
+  }
+  reach.Dilate();
+
+  std::vector<uint8_t> flagged(selected.size(), 0);
+  for (const ReferenceSweep& reference : references) {
+    CHECK(reference.points != nullptr);
+    FlagAgainst(current, selected, representative, queried, reference, &reach, options, &flagged);
   }
   for (size_t k = 0; k < selected.size(); ++k) {
-    if (is_dynamic[point_cluster[k]]) {
+    result.flagged_points += flagged[k];
+    clusters[point_cluster[k]].flagged += flagged[k];
+  }
+  auto removed = [&](const ClusterStats& s) {
+    return judged(s) && s.flagged >= options.min_flagged_points &&
+           s.flagged >= options.min_flagged_fraction * s.points;
+  };
+  for (const ClusterStats& s : clusters) result.dynamic_clusters += s.points > 0 && removed(s);
+  for (size_t k = 0; k < selected.size(); ++k) {
+    if (removed(clusters[point_cluster[k]])) {
       result.dynamic[selected[k]] = 1;
       ++result.removed_points;
     }

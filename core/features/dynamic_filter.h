@@ -17,15 +17,19 @@ namespace stcalib {
 // The current non-ground points are clustered (Euclidean, on a voxel grid) and whole clusters
 // with enough flagged points are removed.
 struct DynamicFilterOptions {
-  double tau0_m = 0.15;                ///< τ0 [m]
-  double tau_per_range = 0.008;        ///< k [m/m]: beam spacing grows with range
-  double max_range_m = 80.0;           ///< points beyond are left alone [m]
-  double roi_half_angle_deg = 0.0;     ///< only |azimuth| ≤ this (camera view); 0 = all
-  double cluster_tolerance_m = 0.45;   ///< voxel size of the clustering [m]
-  int min_flagged_points = 6;          ///< a dynamic cluster has at least this many flagged
-  double min_flagged_fraction = 0.12;  ///< ... and at least this share of its points flagged
-  double max_cluster_extent_m = 14.0;  ///< larger clusters are structure, never removed [m]
-  double visibility_margin_m = 0.3;    ///< previous range must exceed ours by this (+2 %) [m]
+  double tau0_m = 0.15;          ///< τ0 [m]
+  double tau_per_range = 0.008;  ///< k [m/m]: beam spacing grows with range
+  double max_range_m = 80.0;     ///< points beyond are left alone [m]
+  // The camera's view, as an azimuth window |azimuth − centre| ≤ half angle: only clusters that
+  // reach into it are judged, each exactly as without the window (all its points, against the
+  // whole reference); clusters wholly outside it are left unjudged (kept). 0 = judge all [deg].
+  double roi_half_angle_deg = 0.0;
+  double roi_center_azimuth_deg = 0.0;  ///< LiDAR azimuth of the window's centre [deg]
+  double cluster_tolerance_m = 0.45;    ///< voxel size of the clustering [m]
+  int min_flagged_points = 6;           ///< a dynamic cluster has at least this many flagged
+  double min_flagged_fraction = 0.12;   ///< ... and at least this share of its points flagged
+  double max_cluster_extent_m = 14.0;   ///< larger clusters are structure, never removed [m]
+  double visibility_margin_m = 0.3;     ///< previous range must exceed ours by this (+2 %) [m]
   // Slow movers (pedestrians) shift less than τ between adjacent sweeps; a second, older
   // reference sweep this far back, compared with the visibility check, catches them [s].
   double long_baseline_s = 0.3;
@@ -39,8 +43,11 @@ struct DynamicFilterOptions {
 
 struct DynamicFilterResult {
   std::vector<uint8_t> dynamic;  ///< one per current point: 1 = removed as dynamic
-  int flagged_points = 0;        ///< points beyond τ(r)
-  int clusters = 0;              ///< clusters examined
+  // Points beyond τ(r), among the clusters judged: in the view, no wider than
+  // max_cluster_extent_m and with at least min_flagged_points points (no other can be removed,
+  // so no other is queried).
+  int flagged_points = 0;
+  int clusters = 0;  ///< clusters found
   int dynamic_clusters = 0;
   int removed_points = 0;
 };

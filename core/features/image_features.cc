@@ -221,9 +221,13 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     cv::distanceTransform(255 - horizontal, features.distance_horizontal_raw_px, cv::DIST_L2, mask);
   }
   const cv::Mat& distance = features.distance_raw_px;
-  features.idt = InverseDistanceTransform(distance, options.basin_px, options.smoothing_sigma_px);
-  features.idt_bandpass = BandPass(features.idt, options.suppression_sigma_px);
-  cv::max(features.idt_bandpass, 0.0, features.idt_suppressed);
+  if (!options.split_orientation || options.unsplit_maps) {
+    features.idt = InverseDistanceTransform(distance, options.basin_px, options.smoothing_sigma_px);
+    features.idt_bandpass = BandPass(features.idt, options.suppression_sigma_px);
+    cv::max(features.idt_bandpass, 0.0, features.idt_suppressed);
+    cv::min(distance, options.basin_px, features.distance_px);
+    Smooth(&features.distance_px, options.smoothing_sigma_px);
+  }
   for (size_t i = 0; i < UnsplitPyramidLevels(options); ++i) {
     const double basin = options.pyramid_basins_px[i];
     cv::Mat level =
@@ -233,8 +237,6 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     }
     features.idt_pyramid.push_back(level);
   }
-  cv::min(distance, options.basin_px, features.distance_px);
-  Smooth(&features.distance_px, options.smoothing_sigma_px);
   if (options.split_orientation) {
     const cv::Mat* raw[2] = {&features.distance_vertical_raw_px,
                              &features.distance_horizontal_raw_px};

@@ -38,6 +38,9 @@ struct ImageFeatureOptions {
   // lines with one distance map each, so that vertical LiDAR edges are compared with vertical
   // image edges only (dense texture has every orientation; structure has one).
   bool split_orientation = false;
+  // With split_orientation: also the unsplit smoothed maps (idt, idt_suppressed, idt_bandpass,
+  // distance_px). Whoever reads only the oriented maps saves a blur, a band-pass and a min.
+  bool unsplit_maps = true;
   bool precise_distance = false;  ///< exact Euclidean DT (5.6 ms) instead of the 3×3 mask (3.3 ms)
   // Rectangle of interest (x, y, w, h) [px]; empty = whole image. Outside it the maps are flat.
   cv::Rect region_of_interest;
@@ -60,7 +63,8 @@ struct ImageFeatures {
   cv::Mat distance_px;      ///< CV_32F, smoothed min(D, basin) [px]; 0 on edges
   cv::Mat distance_vertical_raw_px;    ///< to near-vertical edge pixels [px] (split_orientation)
   cv::Mat distance_horizontal_raw_px;  ///< to near-horizontal edge pixels [px] (split_orientation)
-  cv::Mat idt;                         ///< CV_32F, smoothed IDT in [0, 255]
+  // The unsplit maps (empty with split_orientation and not unsplit_maps):
+  cv::Mat idt;             ///< CV_32F, smoothed IDT in [0, 255]
   cv::Mat idt_suppressed;  ///< CV_32F, max(0, IDT − wide blur of IDT): dense texture fades
   cv::Mat idt_bandpass;    ///< CV_32F, IDT − wide blur of IDT, not clipped (see BandPass)
   std::vector<cv::Mat> idt_pyramid;  ///< IDTs at pyramid_basins_px (suppressed if asked);

@@ -2,6 +2,8 @@
 
 #include <glog/logging.h>
 
+#include <cmath>
+
 #include "core/score/projection.h"
 
 namespace stcalib {
@@ -11,10 +13,53 @@ Status FrameSourceOptions::Validate() const {
   return lidar.Validate();
 }
 
+ImageFeatureOptions FrameSourceOptions::ImageOptions() const {
+  ImageFeatureOptions options = image;
+  options.suppress_pyramid = suppress_texture;
+  options.split_orientation = oriented_maps;
+  options.unsplit_maps = !oriented_maps;  // Load reads the oriented maps only
+  return options;
+}
+
+Eigen::Vector2d CameraAzimuthWindowDeg(const CameraCalibration& camera, int image_width,
+                                       int image_height, const Rigid3d& T_camera_lidar,
+                                       double margin_deg) {
+  const double fx = camera.P_rect_02(0, 0), fy = camera.P_rect_02(1, 1);
+  const double cx = camera.P_rect_02(0, 2), cy = camera.P_rect_02(1, 2);
+  // Rectified camera ray -> LiDAR direction.
+  const Eigen::Matrix3d R_lidar_rect =
+      T_camera_lidar.linear().transpose() * camera.R_rect_00.transpose();
+  auto direction = [&](double u, double v) {
+    return (R_lidar_rect * Eigen::Vector3d((u - cx) / fx, (v - cy) / fy, 1.0)).normalized();
+  };
+  const Eigen::Vector3d axis = direction(cx, cy);
+  if (std::abs(axis.z()) > 0.9) return Eigen::Vector2d::Zero();
+  const double center = std::atan2(axis.y(), axis.x());
+  double half = 0;
+  for (double u : {0.0, 0.5 * image_width, static_cast<double>(image_width)}) {
+    for (double v : {0.0, 0.5 * image_height, static_cast<double>(image_height)}) {
+      const Eigen::Vector3d d = direction(u, v);
+      half = std::max(half, std::abs(std::remainder(std::atan2(d.y(), d.x()) - center, 2 * M_PI)));
+    }
+  }
+  const double half_deg = half * 180.0 / M_PI + margin_deg;
+  if (half_deg >= 180) return Eigen::Vector2d::Zero();
+  return Eigen::Vector2d(center * 180.0 / M_PI, half_deg);
+}
+
 Status DriveFrameSource::Create(const Drive* drive, const FrameSourceOptions& options,
                                 std::unique_ptr<DriveFrameSource>* source) {
   STCALIB_RETURN_IF_ERROR(options.Validate());
   std::unique_ptr<DriveFrameSource> s(new DriveFrameSource(drive, options));
+  if (options.view_margin_deg >= 0 && drive->camera.image_width > 0 &&
+      drive->camera.image_height > 0 && drive->camera.P_rect_02(0, 0) > 0 &&
+      drive->camera.P_rect_02(1, 1) > 0) {
+    const Eigen::Vector2d window = CameraAzimuthWindowDeg(
+        drive->camera, drive->camera.image_width, drive->camera.image_height,
+        options.view_T_camera_lidar.value_or(drive->T_camera_lidar), options.view_margin_deg);
+    s->options_.lidar.dynamic.roi_center_azimuth_deg = window.x();
+    s->options_.lidar.dynamic.roi_half_angle_deg = window.y();
+  }
   if (drive->has_oxts) {
     STCALIB_RETURN_IF_ERROR(DriveMotion::Create(*drive, &s->motion_));
   } else {
@@ -43,10 +88,7 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   cv::Mat image;
   STCALIB_RETURN_IF_ERROR(drive_->LoadImage(frame, &image));
   out->camera = MakeCameraModel(drive_->camera, image.cols, image.rows);
-  ImageFeatureOptions image_options = options_.image;
-  image_options.suppress_pyramid = options_.suppress_texture;
-  image_options.split_orientation = options_.oriented_maps;
-  out->image = ExtractImageFeatures(image, image_options);
+  out->image = ExtractImageFeatures(image, options_.ImageOptions());
   for (int kind = 0; kind < 2; ++kind) {
     const bool oriented = options_.oriented_maps && !out->image.empty();
     const OrientedMaps* m = oriented ? &out->image.oriented[kind] : nullptr;

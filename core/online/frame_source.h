@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 
 #include "core/features/image_features.h"
 #include "core/features/lidar_frame.h"
@@ -26,6 +27,13 @@ struct FrameSourceOptions {
   // A frame whose image time lies in a longer gap between oxts packets (or further from the
   // nearest one) is refused: its motion model would be a guess [s].
   double max_oxts_gap_s = 0.25;
+  // The dynamic filter judges only the clusters that reach the camera's horizontal field of
+  // view, widened by this on each side, as `view_T_camera_lidar` (unset: the drive's
+  // calibration) places it; the points the calibration uses are judged exactly as without the
+  // window. It must cover how far the estimate may move from that calibration. Negative: judge
+  // the whole sweep [deg].
+  double view_margin_deg = 20.0;
+  std::optional<Rigid3d> view_T_camera_lidar;
 
   FrameSourceOptions() {
     image.pyramid_basins_px = {60, 30};
@@ -35,11 +43,21 @@ struct FrameSourceOptions {
     lidar.dynamic.min_flagged_fraction = 0.3;
   }
   Status Validate() const;
+  // The image options every frame is extracted with: `image` plus the map choices above.
+  ImageFeatureOptions ImageOptions() const;
 };
 
 // Turns the frames of a drive into CalibrationFrames, in time order: image features, the local
 // map of LiDAR edges (de-skewed, dynamic points removed), the LiDAR twist at the image time and
 // the stamp gap. Sweeps are cached, so a sequential pass computes each one once.
+// The LiDAR azimuth window [centre, half angle] in degrees that holds the camera's horizontal
+// field of view (the rays through the rectified image's corners and edge midpoints) widened by
+// `margin_deg`; a half angle of 0 (the whole sweep) when the camera looks nearly straight up or
+// down, where an azimuth window cannot hold its view.
+Eigen::Vector2d CameraAzimuthWindowDeg(const CameraCalibration& camera, int image_width,
+                                       int image_height, const Rigid3d& T_camera_lidar,
+                                       double margin_deg);
+
 class DriveFrameSource {
  public:
   // The motion model comes from the drive's oxts, or, without oxts/, from registering
@@ -48,6 +66,8 @@ class DriveFrameSource {
                        std::unique_ptr<DriveFrameSource>* source);
   Status Load(size_t frame, CalibrationFrame* out);
   const DriveMotion& motion() const { return motion_; }
+  // The azimuth window the dynamic filter judges (roi_center_azimuth_deg, roi_half_angle_deg).
+  const DynamicFilterOptions& dynamic_options() const { return options_.lidar.dynamic; }
 
  private:
   DriveFrameSource(const Drive* drive, const FrameSourceOptions& options)
