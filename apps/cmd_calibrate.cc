@@ -184,6 +184,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   // The dynamic filter judges the camera's view as the starting calibration places it.
   FrameSourceOptions source_options = job.source;
   source_options.view_T_camera_lidar = initial.T_camera_lidar;
+  if (!job.online.ReadsCoarseLevels()) source_options.image.pyramid_basins_px.clear();
   std::unique_ptr<DriveFrameSource> source;
   status = DriveFrameSource::Create(&drive, source_options, &source);
   if (!status.ok()) return ReportError(kCommand, status);

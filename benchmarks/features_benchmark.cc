@@ -75,13 +75,16 @@ void BM_ImageFeaturesWithPyramid(benchmark::State& state) {
 BENCHMARK(BM_ImageFeaturesWithPyramid)->Unit(benchmark::kMillisecond);
 
 // As the online frame source asks for them (DriveFrameSource::Load): split orientation with
-// its own texture-suppressed pyramid, which is what every calibration frame pays.
+// its own texture-suppressed pyramid, which is what every calibration frame pays. Arg 1: the
+// same without the pyramid (its share of the cost).
 void BM_ImageFeaturesAsOnline(benchmark::State& state) {
   REQUIRE_KITTI(state);
-  const ImageFeatureOptions options = FrameSourceOptions().ImageOptions();
+  ImageFeatureOptions options = FrameSourceOptions().ImageOptions();
+  if (state.range(0) == 1) options.pyramid_basins_px.clear();
   for (auto _ : state) benchmark::DoNotOptimize(ExtractImageFeatures(Kitti().image, options));
+  state.SetLabel(state.range(0) == 1 ? "without the pyramid" : "as online");
 }
-BENCHMARK(BM_ImageFeaturesAsOnline)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ImageFeaturesAsOnline)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // The rows LiDAR points can reach (below the top beam at +2°, with margin), as the online path
 // uses them: rows 110..374 of the 375.

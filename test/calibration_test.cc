@@ -329,6 +329,24 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   EXPECT_LT(std::abs(online_error.time_offset_s), 0.02);
   EXPECT_GT(last.health, 0.8);
 
+  // With the rotation grid (the default) the search never reads the coarse pyramid levels, so
+  // `stcalib calibrate` leaves them out of its frames (ReadsCoarseLevels): the same run on frames
+  // that carry only the finest map ends bit for bit where this one did.
+  ASSERT_FALSE(online_options.ReadsCoarseLevels());
+  ASSERT_GT(frames[0]->score_maps[0].size(), 1u);
+  OnlineCalibrator finest_only(online_options,
+                               Step(truth, Eigen::Vector3d(-2, 2, -2) * M_PI / 180.0,
+                                    Eigen::Vector3d(0.05, -0.05, 0.05), -0.03));
+  for (const auto& frame : frames) {
+    auto stripped = std::make_shared<CalibrationFrame>(*frame);
+    for (std::vector<cv::Mat>& levels : stripped->score_maps)
+      levels.erase(levels.begin(), levels.end() - 1);
+    finest_only.AddFrame(stripped);
+  }
+  EXPECT_TRUE(finest_only.state().T_camera_lidar.matrix() ==
+              calibrator.state().T_camera_lidar.matrix());
+  EXPECT_EQ(finest_only.state().time_offset_s, calibrator.state().time_offset_s);
+
   // The paper's protocol, short: a 2° disturbance on each axis (3.5°) of the running estimate;
   // the last frames again (restamped later) bring it back.
   const CalibrationState settled = calibrator.state();
