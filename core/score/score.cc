@@ -21,6 +21,31 @@ inline float Sample(const cv::Mat& map, double u, double v) {
 
 }  // namespace
 
+const std::vector<Eigen::Matrix<double, 6, 1>>& NeighbourDirections(bool translation) {
+  static const std::vector<Eigen::Matrix<double, 6, 1>> all = [] {
+    std::vector<Eigen::Matrix<double, 6, 1>> d;
+    for (int code = 0; code < 729; ++code) {
+      if (code == 364) continue;  // the centre
+      Eigen::Matrix<double, 6, 1> v;
+      int c = code;
+      for (int k = 0; k < 6; ++k) {
+        v[k] = c % 3 - 1;
+        c /= 3;
+      }
+      d.push_back(v);
+    }
+    return d;
+  }();
+  static const std::vector<Eigen::Matrix<double, 6, 1>> rotation_only = [] {
+    std::vector<Eigen::Matrix<double, 6, 1>> d;
+    for (const auto& v : all) {
+      if (v.tail<3>().isZero()) d.push_back(v);
+    }
+    return d;
+  }();
+  return translation ? all : rotation_only;
+}
+
 CalibrationState Step(const CalibrationState& state, const Eigen::Vector3d& rotation_rad,
                       const Eigen::Vector3d& translation_m, double time_offset_s) {
   CalibrationState out = state;
@@ -141,6 +166,72 @@ ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& 
   return value;
 }
 
+std::vector<ScoreValue> WindowScorer::EvaluateNeighbours(
+    const CalibrationState& state, double rotation_rad, double translation_m,
+    const std::vector<Eigen::Matrix<double, 6, 1>>& directions, int level) {
+  // The neighbours as Step() makes them, grouped by their rotation.
+  std::vector<CalibrationState> neighbours;
+  std::vector<std::vector<size_t>> groups;
+  std::vector<Eigen::Vector3d> group_rotation;
+  for (size_t n = 0; n < directions.size(); ++n) {
+    const Eigen::Vector3d r = directions[n].head<3>();
+    neighbours.push_back(
+        Step(state, rotation_rad * r, translation_m * directions[n].tail<3>(), 0.0));
+    size_t g = 0;
+    while (g < group_rotation.size() && group_rotation[g] != r) ++g;
+    if (g == group_rotation.size()) {
+      group_rotation.push_back(r);
+      groups.emplace_back();
+    }
+    groups[g].push_back(n);
+  }
+  std::vector<ScoreValue> values(directions.size());
+  double weight_sum = 0;
+  std::vector<Eigen::Vector3d> b(directions.size());
+  std::vector<double> depth_offset(directions.size());
+  for (size_t f = 0; f < frames_.size(); ++f) {
+    const CalibrationFrame& cf = *frames_[f];
+    const int maps_count = static_cast<int>(cf.score_maps[0].size());
+    const int l = level < 0 ? maps_count + level : level;
+    CHECK(l >= 0 && l < maps_count && l < static_cast<int>(cf.score_maps[1].size()))
+        << "score level " << level << " of " << maps_count;
+    const cv::Mat* maps[2] = {&cf.score_maps[0][l], &cf.score_maps[1][l]};
+    const std::vector<Eigen::Vector3d>& moved = Moved(f, state.time_offset_s);
+    for (size_t k = 0; k < moved.size(); ++k) weight_sum += weights_[f][k];
+    // As EvaluateOn: h = M·p + b, depth = depth_row·p + depth_offset.
+    const Eigen::Matrix3d KR = cf.camera.P_rect_02.leftCols<3>() * cf.camera.R_rect_00;
+    for (size_t n = 0; n < neighbours.size(); ++n) {
+      const Rigid3d& T = neighbours[n].T_camera_lidar;
+      b[n] = KR * T.translation() + cf.camera.P_rect_02.col(3);
+      depth_offset[n] = cf.camera.R_rect_00.row(2).dot(T.translation());
+    }
+    for (const std::vector<size_t>& group : groups) {
+      const Eigen::Matrix3d& R = neighbours[group.front()].T_camera_lidar.linear();
+      const Eigen::Matrix3d M = KR * R;
+      const Eigen::Vector3d depth_row = cf.camera.R_rect_00.row(2) * R;
+      for (size_t k = 0; k < moved.size(); ++k) {
+        const float w = weights_[f][k];
+        const double depth = depth_row.dot(moved[k]);
+        const Eigen::Vector3d Mp = M * moved[k];
+        const cv::Mat& map = *maps[kinds_[f][k]];
+        for (size_t n : group) {
+          if (depth + depth_offset[n] < cf.camera.min_depth_m) continue;
+          const Eigen::Vector3d h = Mp + b[n];
+          const double u = h.x() / h.z(), v = h.y() / h.z();
+          const float s = Sample(map, u, v);
+          if (u >= 0 && v >= 0 && u < map.cols && v < map.rows) ++values[n].projected;
+          values[n].score += w * s;
+        }
+      }
+    }
+  }
+  for (ScoreValue& value : values) {
+    value.gray_rate = weight_sum > 0 ? value.score / 255.0 / weight_sum : 0.0;
+    value.weight_sum = weight_sum;
+  }
+  return values;
+}
+
 std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& frame,
                                                      const CalibrationState& state, double margin) {
   auto pruned = std::make_shared<CalibrationFrame>(frame);
@@ -165,20 +256,11 @@ double HealthScore(WindowScorer* scorer, const CalibrationState& state, double r
                    double translation_m, double* best_gain) {
   const double centre = scorer->Evaluate(state, -1).score;
   double best = -std::numeric_limits<double>::infinity();
-  const double r = rotation_deg * M_PI / 180.0;
   int worse = 0, total = 0;
-  for (int code = 0; code < 729; ++code) {
-    if (code == 364) continue;  // the centre
-    int c = code;
-    Eigen::Matrix<double, 6, 1> d;
-    for (int k = 0; k < 6; ++k) {
-      d[k] = c % 3 - 1;
-      c /= 3;
-    }
-    const CalibrationState n = Step(state, r * d.head<3>(), translation_m * d.tail<3>(), 0.0);
-    const double value = scorer->Evaluate(n, -1).score;
-    worse += value < centre;
-    best = std::max(best, value);
+  for (const ScoreValue& neighbour : scorer->EvaluateNeighbours(
+           state, rotation_deg * M_PI / 180.0, translation_m, NeighbourDirections(true), -1)) {
+    worse += neighbour.score < centre;
+    best = std::max(best, neighbour.score);
     ++total;
   }
   if (best_gain != nullptr) *best_gain = centre > 0 ? best / centre - 1.0 : 0.0;

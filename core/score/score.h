@@ -38,6 +38,12 @@ class WindowScorer {
   size_t num_frames() const { return frames_.size(); }
   const CalibrationFrame& frame(size_t f) const { return *frames_[f]; }
   const ScoreOptions& options() const { return options_; }
+  // Evaluate() of each neighbour Step(state, rotation_rad·d.head<3>(), translation_m·d.tail<3>(),
+  // 0) for d in `directions`, bit for bit: the neighbours that share a rotation share its
+  // projection products, so a 728-neighbourhood costs about half of 728 Evaluate() calls.
+  std::vector<ScoreValue> EvaluateNeighbours(
+      const CalibrationState& state, double rotation_rad, double translation_m,
+      const std::vector<Eigen::Matrix<double, 6, 1>>& directions, int level);
   // Evaluate() on frame `f` alone. The window's score is the sum of these in frame order up to
   // rounding (Evaluate() accumulates point by point across frames).
   ScoreValue EvaluateFrame(size_t f, const CalibrationState& state, int level);
@@ -63,6 +69,11 @@ class WindowScorer {
   double cached_time_offset_s_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<std::vector<Eigen::Vector3d>> moved_;
 };
+
+// The 728 neighbour directions of the 6-DoF grid (method.md §6), each component in {−1, 0, 1}
+// (rotation first, then translation), in a fixed order; with `translation` false the 26 that
+// move the rotation only.
+const std::vector<Eigen::Matrix<double, 6, 1>>& NeighbourDirections(bool translation);
 
 // Applies a step to a calibration: rotation as roll/pitch/yaw about the LiDAR axes [rad]
 // (R·Exp(Δ)), translation in the camera frame [m], time offset [s].

@@ -11,32 +11,6 @@ namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-// The 728 neighbour directions, each component in {−1, 0, 1}.
-const std::vector<Eigen::Matrix<double, 6, 1>>& Directions(bool translation) {
-  static const std::vector<Eigen::Matrix<double, 6, 1>> all = [] {
-    std::vector<Eigen::Matrix<double, 6, 1>> d;
-    for (int code = 0; code < 729; ++code) {
-      if (code == 364) continue;
-      Eigen::Matrix<double, 6, 1> v;
-      int c = code;
-      for (int k = 0; k < 6; ++k) {
-        v[k] = c % 3 - 1;
-        c /= 3;
-      }
-      d.push_back(v);
-    }
-    return d;
-  }();
-  static const std::vector<Eigen::Matrix<double, 6, 1>> rotation_only = [] {
-    std::vector<Eigen::Matrix<double, 6, 1>> d;
-    for (const auto& v : all) {
-      if (v.tail<3>().isZero()) d.push_back(v);
-    }
-    return d;
-  }();
-  return translation ? all : rotation_only;
-}
-
 }  // namespace
 
 Status AdaptiveGridSearchOptions::Validate() const {
@@ -71,14 +45,16 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
                                 const AdaptiveGridSearchOptions& options) {
   CHECK(options.Validate().ok()) << options.Validate().message();
   // The objective: the score with the translation prior.
-  auto objective = [&](const CalibrationState& state, int level) {
-    const ScoreValue v = scorer->Evaluate(state, level);
+  auto objective_of = [&](const CalibrationState& state, const ScoreValue& v) {
     const double z =
         (state.T_camera_lidar.translation() - anchor.T_camera_lidar.translation()).norm() /
         options.translation_prior_sigma_m;
     const double zt =
         (state.time_offset_s - anchor.time_offset_s) / options.time_offset_prior_sigma_s;
     return v.score - options.translation_prior_weight * 255.0 * v.weight_sum * (z * z + zt * zt);
+  };
+  auto objective = [&](const CalibrationState& state, int level) {
+    return objective_of(state, scorer->Evaluate(state, level));
   };
   SearchResult result;
   result.state = start;
@@ -87,8 +63,8 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
   for (int level = std::clamp(options.first_level, 0, std::max(levels - 1, 0)); level < levels;
        ++level) {
     const bool finest = level == levels - 1;
-    const auto& directions =
-        Directions(options.search_translation && (finest || !options.coarse_levels_rotation_only));
+    const auto& directions = NeighbourDirections(options.search_translation &&
+                                                 (finest || !options.coarse_levels_rotation_only));
     const bool search_time = options.search_time_offset && finest;
     CalibrationState& state = result.state;
     double current = objective(state, level);
@@ -100,10 +76,13 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
       const double trans = large ? options.alpha2_translation_m : options.alpha4_translation_m;
       double best = current;
       Eigen::Matrix<double, 6, 1> best_dir = Eigen::Matrix<double, 6, 1>::Zero();
-      for (const auto& d : directions) {
+      const std::vector<ScoreValue> values =
+          scorer->EvaluateNeighbours(state, rot, trans, directions, level);
+      for (size_t n = 0; n < directions.size(); ++n) {
+        const Eigen::Matrix<double, 6, 1>& d = directions[n];
         const CalibrationState candidate = Step(state, rot * d.head<3>(), trans * d.tail<3>(), 0.0);
         if (!WithinBounds(candidate, anchor, options)) continue;
-        const double s = objective(candidate, level);
+        const double s = objective_of(candidate, values[n]);
         if (s > best) {
           best = s;
           best_dir = d;
@@ -200,12 +179,11 @@ RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationSta
                                      scorer->options().horizontal_weight,
                                      scorer->options().max_points_per_frame,
                                      std::move(in_bounds)};
-  if (!cache->valid_ || !(cache->lattice_ == lattice)) {
+  if (!cache->lattice_ || !(*cache->lattice_ == lattice)) {
     cache->scores_.clear();
     cache->lattice_ = std::move(lattice);
-    cache->valid_ = true;
   }
-  const std::vector<uint8_t>& mask = cache->lattice_.in_bounds;
+  const std::vector<uint8_t>& mask = cache->lattice_->in_bounds;
   // Per-frame scores, from the cache or computed; frames no longer in the window forgotten.
   auto score_frame = [&](size_t f) {
     std::vector<double> scores(points.size(), 0.0);

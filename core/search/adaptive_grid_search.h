@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -108,8 +109,7 @@ class RotationGridCache {
     std::vector<uint8_t> in_bounds;  // per lattice point
     bool operator==(const Lattice& o) const;
   };
-  Lattice lattice_;
-  bool valid_ = false;
+  std::optional<Lattice> lattice_;  // the lattice the scores belong to; none before the first
   std::map<FrameKey, std::vector<double>> scores_;  // per lattice point (0 when out of bounds)
   int frames_scored_ = 0;
 };
