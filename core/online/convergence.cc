@@ -2,6 +2,7 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -104,14 +105,14 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   } else if (last.points < options.min_points) {
     verdict.reason = "not converged: no usable features (" + std::to_string(last.points) +
                      " LiDAR edge points in the image)";
-  } else if (calibrator.options().wait_for_full_window &&
-             verdict.used_frames < calibrator.options().window_frames) {
+  } else if (std::none_of(used.begin(), used.end(),
+                          [](const FrameReport* r) { return r->search.evaluations > 0; })) {
     // Not even one update: say so, or the start would read as an estimate.
-    verdict.reason = "not converged: " + std::to_string(verdict.used_frames) +
-                     " usable frame(s), fewer than the search window's " +
+    verdict.reason = "not converged: none of the " + std::to_string(verdict.used_frames) +
+                     " usable frame(s) ran a search (the search window holds " +
                      std::to_string(calibrator.options().window_frames) +
-                     ", so the estimate was never updated (a search window of 1 frame estimates "
-                     "from a single frame)";
+                     "), so the estimate was never updated (a search window of 1 frame "
+                     "estimates from a single frame)";
   } else if (verdict.used_frames < options.min_frames) {
     verdict.reason = "not converged: " + std::to_string(verdict.used_frames) +
                      " usable frame(s) cannot show that the estimate has settled (" +
