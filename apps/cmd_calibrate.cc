@@ -54,12 +54,17 @@ cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
                         const CalibrationState& state, const std::string& title) {
   cv::Mat canvas;
   image.convertTo(canvas, CV_8UC3, 0.55);
+  // Distance to any image edge (the frame source keeps only the oriented maps).
+  cv::Mat distance_px = frame.image.distance_raw_px;
+  if (distance_px.empty() && !frame.image.edge_mask.empty()) {
+    cv::distanceTransform(255 - frame.image.edge_mask, distance_px, cv::DIST_L2, cv::DIST_MASK_3);
+  }
   for (size_t i = 0; i < frame.size(); ++i) {
     Eigen::Vector2d pixel;
     if (!ProjectFramePoint(frame, state, i, &pixel) || !frame.camera.InImage(pixel)) continue;
     const int u = static_cast<int>(std::lround(pixel.x())),
               v = static_cast<int>(std::lround(pixel.y()));
-    const bool near = frame.image.distance_raw_px.at<float>(v, u) <= 2.0f;
+    const bool near = !distance_px.empty() && distance_px.at<float>(v, u) <= 2.0f;
     cv::circle(canvas, cv::Point(u, v), 2, near ? cv::Scalar(60, 255, 60) : cv::Scalar(40, 40, 255),
                cv::FILLED);
   }

@@ -116,6 +116,39 @@ TEST(ImageFeatures, SplitOrientationBuildsThePyramidOnTheOrientedMapsOnly) {
   }
 }
 
+// Without the unsplit maps (as the frame source asks, reading only the oriented ones) the
+// oriented maps are the same bit for bit, and the unsplit ones are left empty.
+TEST(ImageFeatures, OrientedMapsAloneEqualThoseBesideTheUnsplitOnes) {
+  cv::Mat image(120, 200, CV_8UC3, cv::Scalar::all(60));
+  cv::rectangle(image, cv::Rect(50, 30, 60, 50), cv::Scalar::all(200), cv::FILLED);
+  cv::line(image, cv::Point(120, 100), cv::Point(190, 20), cv::Scalar::all(220), 2);
+  ImageFeatureOptions options;
+  options.split_orientation = true;
+  options.pyramid_basins_px = {40};
+  const ImageFeatures both = ExtractImageFeatures(image, options);
+  options.unsplit_maps = false;
+  const ImageFeatures alone = ExtractImageFeatures(image, options);
+  ASSERT_FALSE(alone.empty());
+  for (const cv::Mat* m : {&alone.distance_raw_px, &alone.idt, &alone.idt_suppressed,
+                           &alone.idt_bandpass, &alone.distance_px}) {
+    EXPECT_TRUE(m->empty());
+  }
+  EXPECT_FALSE(both.idt.empty());
+  EXPECT_EQ(cv::norm(alone.distance_vertical_raw_px, both.distance_vertical_raw_px, cv::NORM_INF),
+            0);
+  EXPECT_EQ(
+      cv::norm(alone.distance_horizontal_raw_px, both.distance_horizontal_raw_px, cv::NORM_INF), 0);
+  for (int o = 0; o < 2; ++o) {
+    const OrientedMaps &a = alone.oriented[o], &b = both.oriented[o];
+    EXPECT_EQ(cv::norm(a.idt, b.idt, cv::NORM_INF), 0);
+    EXPECT_EQ(cv::norm(a.idt_bandpass, b.idt_bandpass, cv::NORM_INF), 0);
+    EXPECT_EQ(cv::norm(a.idt_suppressed, b.idt_suppressed, cv::NORM_INF), 0);
+    EXPECT_EQ(cv::norm(a.distance_px, b.distance_px, cv::NORM_INF), 0);
+    ASSERT_EQ(a.pyramid.size(), 1u);
+    EXPECT_EQ(cv::norm(a.pyramid[0], b.pyramid[0], cv::NORM_INF), 0);
+  }
+}
+
 // The band-pass map (BandPass) averages to zero over dense texture, so moving points into a
 // textured region gains nothing; the clipped map (SuppressTexture) keeps the positive half-wave
 // and rewards it. An isolated edge is a positive peak in both.

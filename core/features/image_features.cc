@@ -206,9 +206,13 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
   }
 
   const int mask = options.precise_distance ? cv::DIST_MASK_PRECISE : cv::DIST_MASK_3;
-  cv::distanceTransform(255 - features.edge_mask, features.distance_raw_px, cv::DIST_L2, mask);
+  const bool unsplit = !options.split_orientation || options.unsplit_maps;
+  if (unsplit) {
+    cv::distanceTransform(255 - features.edge_mask, features.distance_raw_px, cv::DIST_L2, mask);
+  }
   if (options.split_orientation) {
-    // Gradient mostly along x = a near-vertical line; the 30° band in between goes to both.
+    // Gradient mostly along x = a near-vertical line; the 30° band in between (diagonal lines)
+    // goes to neither.
     cv::Mat gx, gy;
     cv::Sobel(blurred, gx, CV_32F, 1, 0, 3);
     cv::Sobel(blurred, gy, CV_32F, 0, 1, 3);
@@ -221,7 +225,7 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     cv::distanceTransform(255 - horizontal, features.distance_horizontal_raw_px, cv::DIST_L2, mask);
   }
   const cv::Mat& distance = features.distance_raw_px;
-  if (!options.split_orientation || options.unsplit_maps) {
+  if (unsplit) {
     features.idt = InverseDistanceTransform(distance, options.basin_px, options.smoothing_sigma_px);
     features.idt_bandpass = BandPass(features.idt, options.suppression_sigma_px);
     cv::max(features.idt_bandpass, 0.0, features.idt_suppressed);

@@ -38,8 +38,9 @@ struct ImageFeatureOptions {
   // lines with one distance map each, so that vertical LiDAR edges are compared with vertical
   // image edges only (dense texture has every orientation; structure has one).
   bool split_orientation = false;
-  // With split_orientation: also the unsplit smoothed maps (idt, idt_suppressed, idt_bandpass,
-  // distance_px). Whoever reads only the oriented maps saves a blur, a band-pass and a min.
+  // With split_orientation: also the unsplit maps (distance_raw_px, idt, idt_suppressed,
+  // idt_bandpass, distance_px). Whoever reads only the oriented maps saves a distance transform,
+  // a blur, a band-pass and a min.
   bool unsplit_maps = true;
   bool precise_distance = false;  ///< exact Euclidean DT (5.6 ms) instead of the 3×3 mask (3.3 ms)
   // Rectangle of interest (x, y, w, h) [px]; empty = whole image. Outside it the maps are flat.
@@ -60,6 +61,7 @@ struct OrientedMaps {
 struct ImageFeatures {
   cv::Mat edge_mask;        ///< CV_8U, 255 on edge pixels
   cv::Mat distance_raw_px;  ///< CV_32F, distance to the nearest edge pixel [px], unsmoothed
+                            ///< (empty with split_orientation and not unsplit_maps)
   cv::Mat distance_px;      ///< CV_32F, smoothed min(D, basin) [px]; 0 on edges
   cv::Mat distance_vertical_raw_px;    ///< to near-vertical edge pixels [px] (split_orientation)
   cv::Mat distance_horizontal_raw_px;  ///< to near-horizontal edge pixels [px] (split_orientation)
