@@ -39,6 +39,28 @@ struct OxtsMotion {
   OxtsTrajectory trajectory;
 };
 
+// The two earlier sweeps the dynamic filter compares a simulated frame with (the adjacent one
+// and the one 0.3 s back, as LoadLidarFrameFeatures picks them), their bases in `bases`.
+std::vector<ReferenceFeatures> SimulatedReferences(const Simulator& s, const OxtsMotion& motion,
+                                                   int frame, const LidarFeatureOptions& options,
+                                                   std::vector<LidarFrameFeatures>* bases) {
+  bases->clear();
+  for (int gap : {1, 3}) {
+    bases->push_back(ComputeLidarSweepBase(s.SimulateSweep(frame - gap).scan,
+                                           s.LidarMidTime(frame - gap), s.SweepDuration(), motion,
+                                           options));
+  }
+  std::vector<ReferenceFeatures> references;
+  for (int k = 0; k < 2; ++k) {
+    ReferenceFeatures r;
+    r.features = &(*bases)[k];
+    r.T_current_reference = RelativeLidarPose(motion, s.LidarMidTime(frame), (*bases)[k].stamp_s);
+    r.check_visibility = k == 1;
+    references.push_back(r);
+  }
+  return references;
+}
+
 TEST(OxtsTrajectory, RelativePosesMatchTheSimulatedTruth) {
   SimulatorOptions options;
   options.seed = 21;
@@ -140,22 +162,10 @@ TEST(DynamicFilter, RemovesMovingObjectsAndKeepsStructure) {
     const OxtsMotion motion(s);
     const LidarFeatureOptions feature_options;
     for (int frame : {3, 14, 27}) {
-      // The adjacent sweep and the one 0.3 s back, as LoadLidarFrameFeatures picks them.
       std::vector<LidarFrameFeatures> bases;
-      std::vector<ReferenceFeatures> references;
+      const std::vector<ReferenceFeatures> references =
+          SimulatedReferences(s, motion, frame, feature_options, &bases);
       const double t = s.LidarMidTime(frame);
-      for (int gap : {1, 3}) {
-        bases.push_back(ComputeLidarSweepBase(s.SimulateSweep(frame - gap).scan,
-                                              s.LidarMidTime(frame - gap), s.SweepDuration(),
-                                              motion, feature_options));
-      }
-      for (int k = 0; k < 2; ++k) {
-        ReferenceFeatures r;
-        r.features = &bases[k];
-        r.T_current_reference = RelativeLidarPose(motion, t, bases[k].stamp_s);
-        r.check_visibility = k == 1;
-        references.push_back(r);
-      }
       const sim::SimulatedSweep sweep = s.SimulateSweep(frame);
       const LidarFrameFeatures f = ComputeLidarFrameFeatures(sweep.scan, t, s.SweepDuration(),
                                                              motion, references, feature_options);
@@ -202,17 +212,11 @@ TEST(DynamicFilter, ViewWindowJudgesItsClustersExactlyAsTheWholeSweep) {
   for (int frame : {4, 15}) {
     const double t = s.LidarMidTime(frame);
     std::vector<LidarFrameFeatures> bases;
-    for (int gap : {1, 3}) {
-      bases.push_back(ComputeLidarSweepBase(s.SimulateSweep(frame - gap).scan,
-                                            s.LidarMidTime(frame - gap), s.SweepDuration(), motion,
-                                            feature_options));
-    }
-    std::vector<ReferenceSweep> references(2);
-    for (int k = 0; k < 2; ++k) {
-      references[k].points = &bases[k].deskewed;
-      references[k].ground = &bases[k].ground;
-      references[k].T_current_reference = RelativeLidarPose(motion, t, bases[k].stamp_s);
-      references[k].check_visibility = k == 1;
+    std::vector<ReferenceSweep> references;
+    for (const ReferenceFeatures& r :
+         SimulatedReferences(s, motion, frame, feature_options, &bases)) {
+      references.push_back(
+          {&r.features->deskewed, &r.features->ground, r.T_current_reference, r.check_visibility});
     }
     const LidarFrameFeatures current = ComputeLidarSweepBase(
         s.SimulateSweep(frame).scan, t, s.SweepDuration(), motion, feature_options);
