@@ -39,6 +39,14 @@ struct OxtsMotion {
   OxtsTrajectory trajectory;
 };
 
+// A simulated drive of `frames` frames from `seed`, otherwise the defaults.
+SimulatorOptions SimOptions(uint64_t seed, int frames) {
+  SimulatorOptions options;
+  options.seed = seed;
+  options.frames = frames;
+  return options;
+}
+
 // The two earlier sweeps the dynamic filter compares a simulated frame with (the adjacent one
 // and the one 0.3 s back, as LoadLidarFrameFeatures picks them), their bases in `bases`.
 std::vector<ReferenceFeatures> SimulatedReferences(const Simulator& s, const OxtsMotion& motion,
@@ -62,10 +70,7 @@ std::vector<ReferenceFeatures> SimulatedReferences(const Simulator& s, const Oxt
 }
 
 TEST(OxtsTrajectory, RelativePosesMatchTheSimulatedTruth) {
-  SimulatorOptions options;
-  options.seed = 21;
-  options.frames = 30;
-  const Simulator s(options);
+  const Simulator s(SimOptions(21, 30));
   const OxtsMotion motion(s);
   for (double t : {0.3, 1.234, 2.05, 2.9}) {
     for (double dt : {0.0105, 0.05, 0.1, -0.1}) {
@@ -155,10 +160,7 @@ struct DynamicCounts {
 TEST(DynamicFilter, RemovesMovingObjectsAndKeepsStructure) {
   DynamicCounts total;
   for (uint64_t seed : {1u, 2u, 9u}) {
-    SimulatorOptions options;
-    options.seed = seed;
-    options.frames = 30;
-    const Simulator s(options);
+    const Simulator s(SimOptions(seed, 30));
     const OxtsMotion motion(s);
     const LidarFeatureOptions feature_options;
     for (int frame : {3, 14, 27}) {
@@ -202,10 +204,7 @@ TEST(DynamicFilter, RemovesMovingObjectsAndKeepsStructure) {
 // as with the whole sweep (its points keep their verdicts, inside the window and out), and no
 // cluster wholly outside it is removed. Checked with the window ahead and turned to the side.
 TEST(DynamicFilter, ViewWindowJudgesItsClustersExactlyAsTheWholeSweep) {
-  SimulatorOptions options;
-  options.seed = 2;
-  options.frames = 20;
-  const Simulator s(options);
+  const Simulator s(SimOptions(2, 20));
   const OxtsMotion motion(s);
   const LidarFeatureOptions feature_options;
   int in_window_removed = 0, outside_removed_whole = 0;
