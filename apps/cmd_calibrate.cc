@@ -2,6 +2,7 @@
 #include <glog/logging.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -186,9 +187,14 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   initial.time_offset_s = job.perturb_time_s;
   outcome->initial = initial;
   outcome->initial_error = ComputeCalibrationError(initial, outcome->reference_state);
-  // The dynamic filter judges the camera's view as the starting calibration places it.
+  // The dynamic filter judges the camera's view as the starting calibration places it, widened
+  // by at least how far the estimate may turn from it (plus the pruning margin's few degrees).
   FrameSourceOptions source_options = job.source;
   source_options.view_T_camera_lidar = initial.T_camera_lidar;
+  if (source_options.view_margin_deg >= 0) {
+    source_options.view_margin_deg =
+        std::max(source_options.view_margin_deg, job.online.search.max_rotation_offset_deg + 10.0);
+  }
   if (!job.online.ReadsCoarseLevels()) source_options.image.pyramid_basins_px.clear();
   std::unique_ptr<DriveFrameSource> source;
   status = DriveFrameSource::Create(&drive, source_options, &source);

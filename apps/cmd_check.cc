@@ -46,6 +46,7 @@ int RunCheck() {
   source_options.suppress_texture = true;
   source_options.local_map.sweeps = FLAGS_local_map_sweeps;
   source_options.image.pyramid_basins_px.clear();  // the health check reads the finest map only
+  source_options.view_T_camera_lidar = calibration.T_camera_lidar;  // the view it checks
   std::unique_ptr<DriveFrameSource> source;
   status = DriveFrameSource::Create(&drive, source_options, &source);
   if (!status.ok()) return ReportError(kCommand, status);

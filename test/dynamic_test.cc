@@ -249,6 +249,37 @@ TEST(DynamicFilter, ViewWindowJudgesItsClustersExactlyAsTheWholeSweep) {
   EXPECT_GT(outside_removed_whole, 50);  // and the window did leave clusters unjudged
 }
 
+// A car alone on an open road: no reference point lies near it, so its nearest neighbour is
+// beyond τ and it is removed, even though the KD-tree is kept to the places a query can reach
+// (here, none of the reference). The static block far behind keeps its points.
+TEST(DynamicFilter, RemovesAMoverWithNoReferencePointNearby) {
+  auto block = [](const Eigen::Vector3d& corner) {
+    std::vector<Eigen::Vector3d> points;
+    for (int a = 0; a < 4; ++a) {
+      for (int b = 0; b < 4; ++b) {
+        for (int c = 0; c < 4; ++c) points.push_back(corner + 0.15 * Eigen::Vector3d(a, b, c));
+      }
+    }
+    return points;
+  };
+  const std::vector<Eigen::Vector3d> car = block(Eigen::Vector3d(20, 0, 0));
+  const std::vector<Eigen::Vector3d> wall = block(Eigen::Vector3d(-30, 10, 0));
+  std::vector<Eigen::Vector3d> current = car;
+  current.insert(current.end(), wall.begin(), wall.end());
+  ReferenceSweep reference;
+  reference.points = &wall;  // the car was elsewhere (out of range) in the reference sweep
+  for (double half_angle_deg : {0.0, 45.0}) {
+    DynamicFilterOptions options;
+    options.roi_half_angle_deg = half_angle_deg;
+    const DynamicFilterResult result = DetectDynamicPoints(current, {}, {reference}, options);
+    for (size_t i = 0; i < current.size(); ++i) {
+      EXPECT_EQ(result.dynamic[i], i < car.size() ? 1 : 0)
+          << "point " << i << ", window " << half_angle_deg;
+    }
+    EXPECT_EQ(result.dynamic_clusters, 1);
+  }
+}
+
 TEST(LocalMap, KittiMapOfThreeSweepsWithOxtsAndNdt) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;

@@ -47,8 +47,9 @@ class AzimuthWindow {
   double cos_center_, sin_center_, cos_half_;
 };
 
-// Cells of a horizontal grid around the sensor that lie within `reach_m` of a marked point:
-// a reference point outside them cannot be any marked query's neighbour within τ.
+// A horizontal grid around the sensor whose cells are at least τ_max wide: after Dilate(), the
+// marked cells hold every place within τ_max (in x and y) of a marked point, so a reference point
+// outside them cannot be any marked query's neighbour within τ.
 class ReachGrid {
  public:
   ReachGrid(double half_extent_m, double cell_m)
@@ -56,15 +57,13 @@ class ReachGrid {
         half_(static_cast<int>(std::ceil(half_extent_m / cell_m))),
         side_(2 * half_ + 1),
         marked_(static_cast<size_t>(side_) * side_, 0) {}
+  // `p` must lie within the half extent (queried points are within max_range_m).
   void Mark(const Eigen::Vector3d& p) {
     const int i = Index(p);
-    if (i < 0) {
-      outside_ = true;
-    } else {
-      marked_[i] = 1;
-    }
+    CHECK_GE(i, 0) << "reach grid: a queried point off the grid";
+    marked_[i] = 1;
   }
-  // Marks the 8 neighbours of every marked cell (cells are at least the reach wide).
+  // Marks the 8 neighbours of every marked cell.
   void Dilate() {
     std::vector<uint8_t> grown = marked_;
     for (int y = 0; y < side_; ++y) {
@@ -80,10 +79,9 @@ class ReachGrid {
     }
     marked_.swap(grown);
   }
-  // Points off the grid are kept whenever a marked point was off it too.
   bool Reaches(const Eigen::Vector3d& p) const {
     const int i = Index(p);
-    return i < 0 ? outside_ : marked_[i] != 0;
+    return i >= 0 && marked_[i] != 0;
   }
 
  private:
@@ -96,7 +94,6 @@ class ReachGrid {
   double cell_m_;
   int half_, side_;
   std::vector<uint8_t> marked_;
-  bool outside_ = false;
 };
 
 int Find(std::vector<int>& parent, int i) {
@@ -159,35 +156,37 @@ double Tau(const DynamicFilterOptions& options, double range_m) {
 
 // Flags the selected current points with `queried` set that `reference` cannot explain.
 // `representative[k]` is the selected point whose query stands for point k (same query voxel).
-// `reach`, when given, holds every place within τ of a queried point: reference points outside
-// it are left out of the tree, which cannot change a verdict (a neighbour within τ lies inside).
+// `reach` holds every place within τ of a queried point: reference points outside it are left
+// out of the tree, which cannot change a verdict (a neighbour within τ lies inside it; without
+// one the nearest is beyond τ either way).
 void FlagAgainst(const std::vector<Eigen::Vector3d>& current, const std::vector<int>& selected,
                  const std::vector<int>& representative, const std::vector<uint8_t>& queried,
-                 const ReferenceSweep& reference, const ReachGrid* reach,
+                 const ReferenceSweep& reference, const ReachGrid& reach,
                  const DynamicFilterOptions& options, std::vector<uint8_t>* flagged) {
   const std::vector<Eigen::Vector3d>& own = *reference.points;
   std::vector<Eigen::Vector3d> moved;
   moved.reserve(own.size() / 2);
   std::unordered_map<int64_t, char> occupied;
   const double max_r2 = (options.max_range_m + 5.0) * (options.max_range_m + 5.0);
+  bool any_in_range = false;  // a reference to compare with at all
   for (size_t i = 0; i < own.size(); ++i) {
     if (reference.ground != nullptr && !reference.ground->empty() && (*reference.ground)[i])
       continue;
     const Eigen::Vector3d p = reference.T_current_reference * own[i];
     if (p.squaredNorm() > max_r2) continue;
+    any_in_range = true;
     if (options.reference_voxel_m > 0 &&
         !occupied.emplace(VoxelKey(p, options.reference_voxel_m), 1).second) {
       continue;
     }
-    if (reach != nullptr && !reach->Reaches(p)) continue;
+    if (!reach.Reaches(p)) continue;
     moved.push_back(p);
   }
-  if (moved.empty()) return;
-  const PointKdTree tree(moved);
-  std::unique_ptr<RangeImage> view;
-  if (reference.check_visibility) {
-    view = std::make_unique<RangeImage>(own, options.max_range_m + 5.0);
-  }
+  if (!any_in_range) return;
+  // No reference point within reach: every query's nearest neighbour is beyond τ.
+  std::unique_ptr<PointKdTree> tree;
+  if (!moved.empty()) tree = std::make_unique<PointKdTree>(moved);
+  std::unique_ptr<RangeImage> view;  // built when the first flagged point needs it
   const Rigid3d T_reference_current = reference.T_current_reference.inverse();
   std::vector<int8_t> verdict(selected.size(), -1);  // per representative: 0 static, 1 flagged
   for (size_t k = 0; k < selected.size(); ++k) {
@@ -197,13 +196,14 @@ void FlagAgainst(const std::vector<Eigen::Vector3d>& current, const std::vector<
       verdict[rep] = 0;
       const Eigen::Vector3d& p = current[selected[rep]];
       int nearest;
-      double distance;
-      tree.Nearest(p, &nearest, &distance);
+      double distance = std::numeric_limits<double>::infinity();
+      if (tree != nullptr) tree->Nearest(p, &nearest, &distance);
       if (distance > Tau(options, p.norm())) verdict[rep] = 1;
     }
     if (verdict[rep] == 0) continue;
     const Eigen::Vector3d& p = current[selected[k]];
-    if (view != nullptr) {
+    if (reference.check_visibility) {
+      if (view == nullptr) view = std::make_unique<RangeImage>(own, options.max_range_m + 5.0);
       // Seen from the reference viewpoint, was this place free space (a longer return)?
       const Eigen::Vector3d q = T_reference_current * p;
       const double r = q.norm();
@@ -312,16 +312,22 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
   }
   // Where the queries can find a neighbour within τ: cells at least τ_max wide, dilated by one.
   const double tau_max = Tau(options, options.max_range_m);
-  ReachGrid reach(options.max_range_m + 2 * tau_max, std::max(tau_max, 0.5));
+  // (Padded against the KD-tree's single-precision distances.)
+  ReachGrid reach(options.max_range_m + 2 * tau_max, std::max(tau_max, 0.5) + 0.01);
+  bool any_queried = false;
   for (size_t k = 0; k < selected.size(); ++k) {
-    if (queried[k]) reach.Mark(current[selected[representative[k]]]);
+    if (!queried[k]) continue;
+    reach.Mark(current[selected[representative[k]]]);
+    any_queried = true;
   }
   reach.Dilate();
 
   std::vector<uint8_t> flagged(selected.size(), 0);
   for (const ReferenceSweep& reference : references) {
     CHECK(reference.points != nullptr);
-    FlagAgainst(current, selected, representative, queried, reference, &reach, options, &flagged);
+    if (any_queried) {
+      FlagAgainst(current, selected, representative, queried, reference, reach, options, &flagged);
+    }
   }
   for (size_t k = 0; k < selected.size(); ++k) {
     result.flagged_points += flagged[k];

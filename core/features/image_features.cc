@@ -129,6 +129,7 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     const ImageFeatures crop =
         roi.area() > 0 ? ExtractImageFeatures(gray(roi).clone(), crop_options) : ImageFeatures();
     auto embed = [&](const cv::Mat& part, int type, double fill) {
+      if (part.empty() && roi.area() > 0) return cv::Mat();  // a map not asked for stays empty
       cv::Mat out(gray.size(), type, cv::Scalar(fill));
       if (!part.empty()) part.copyTo(out(roi));
       return out;

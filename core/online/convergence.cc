@@ -108,11 +108,11 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   } else if (std::none_of(used.begin(), used.end(),
                           [](const FrameReport* r) { return r->search.evaluations > 0; })) {
     // Not even one update: say so, or the start would read as an estimate.
-    verdict.reason = "not converged: none of the " + std::to_string(verdict.used_frames) +
-                     " usable frame(s) ran a search (the search window holds " +
-                     std::to_string(calibrator.options().window_frames) +
-                     "), so the estimate was never updated (a search window of 1 frame "
-                     "estimates from a single frame)";
+    verdict.reason =
+        "not converged: none of the " + std::to_string(verdict.used_frames) +
+        " usable frame(s) ran a search, so the estimate was never updated (last: " + last.reason +
+        "; the search window holds " + std::to_string(calibrator.options().window_frames) +
+        " frames, and a window of 1 frame estimates from a single frame)";
   } else if (verdict.used_frames < options.min_frames) {
     verdict.reason = "not converged: " + std::to_string(verdict.used_frames) +
                      " usable frame(s) cannot show that the estimate has settled (" +

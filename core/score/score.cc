@@ -19,6 +19,16 @@ inline float Sample(const cv::Mat& map, double u, double v) {
          fv * ((1 - fu) * row1[u0] + fu * row1[u0 + 1]);
 }
 
+// One point's share of a score: the map at the projection of h = K·R_rect·p_camera + p4,
+// weighted, and whether it landed in the image.
+inline void AddProjection(const Eigen::Vector3d& h, const cv::Mat& map, float w,
+                          ScoreValue* value) {
+  const double u = h.x() / h.z(), v = h.y() / h.z();
+  const float s = Sample(map, u, v);
+  if (u >= 0 && v >= 0 && u < map.cols && v < map.rows) ++value->projected;
+  value->score += w * s;
+}
+
 }  // namespace
 
 const std::vector<Eigen::Matrix<double, 6, 1>>& NeighbourDirections(bool translation) {
@@ -154,11 +164,7 @@ ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& 
       weight_sum += w;
       if (depth_row.dot(moved[k]) + depth_offset < cf.camera.min_depth_m) continue;
       const Eigen::Vector3d h = M * moved[k] + b;
-      const double u = h.x() / h.z(), v = h.y() / h.z();
-      const cv::Mat& map = *maps[kinds_[f][k]];
-      const float s = Sample(map, u, v);
-      if (u >= 0 && v >= 0 && u < map.cols && v < map.rows) ++value.projected;
-      value.score += w * s;
+      AddProjection(h, *maps[kinds_[f][k]], w, &value);
     }
   }
   value.gray_rate = weight_sum > 0 ? value.score / 255.0 / weight_sum : 0.0;
@@ -217,10 +223,7 @@ std::vector<ScoreValue> WindowScorer::EvaluateNeighbours(
         for (size_t n : group) {
           if (depth + depth_offset[n] < cf.camera.min_depth_m) continue;
           const Eigen::Vector3d h = Mp + b[n];
-          const double u = h.x() / h.z(), v = h.y() / h.z();
-          const float s = Sample(map, u, v);
-          if (u >= 0 && v >= 0 && u < map.cols && v < map.rows) ++values[n].projected;
-          values[n].score += w * s;
+          AddProjection(h, map, w, &values[n]);
         }
       }
     }
