@@ -175,13 +175,14 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   for (int level : {-1, 0}) {
     const std::vector<Eigen::Matrix<double, 6, 1>>& directions = NeighbourDirections(true);
     ASSERT_EQ(directions.size(), 728u);
-    const std::vector<ScoreValue> batch =
-        scorer.EvaluateNeighbours(one_off, 0.01, 0.03, directions, level);
+    std::vector<CalibrationState> neighbours;
+    for (const Eigen::Matrix<double, 6, 1>& d : directions) {
+      neighbours.push_back(Step(one_off, 0.01 * d.head<3>(), 0.03 * d.tail<3>(), 0.0));
+    }
+    const std::vector<ScoreValue> batch = scorer.EvaluateStates(neighbours, level);
     ASSERT_EQ(batch.size(), directions.size());
     for (size_t n = 0; n < directions.size(); ++n) {
-      const ScoreValue single = scorer.Evaluate(
-          Step(one_off, 0.01 * directions[n].head<3>(), 0.03 * directions[n].tail<3>(), 0.0),
-          level);
+      const ScoreValue single = scorer.Evaluate(neighbours[n], level);
       ASSERT_EQ(batch[n].score, single.score) << "level " << level << ", neighbour " << n;
       ASSERT_EQ(batch[n].projected, single.projected) << "level " << level << ", neighbour " << n;
       ASSERT_EQ(batch[n].weight_sum, single.weight_sum);

@@ -172,29 +172,25 @@ ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& 
   return value;
 }
 
-std::vector<ScoreValue> WindowScorer::EvaluateNeighbours(
-    const CalibrationState& state, double rotation_rad, double translation_m,
-    const std::vector<Eigen::Matrix<double, 6, 1>>& directions, int level) {
-  // The neighbours as Step() makes them, grouped by their rotation.
-  std::vector<CalibrationState> neighbours;
+std::vector<ScoreValue> WindowScorer::EvaluateStates(const std::vector<CalibrationState>& states,
+                                                     int level) {
+  std::vector<ScoreValue> values(states.size());
+  if (states.empty()) return values;
+  // Grouped by their rotation (equal matrices share the projection products).
   std::vector<std::vector<size_t>> groups;
-  std::vector<Eigen::Vector3d> group_rotation;
-  for (size_t n = 0; n < directions.size(); ++n) {
-    const Eigen::Vector3d r = directions[n].head<3>();
-    neighbours.push_back(
-        Step(state, rotation_rad * r, translation_m * directions[n].tail<3>(), 0.0));
+  for (size_t n = 0; n < states.size(); ++n) {
+    CHECK_EQ(states[n].time_offset_s, states[0].time_offset_s) << "EvaluateStates: one δ";
     size_t g = 0;
-    while (g < group_rotation.size() && group_rotation[g] != r) ++g;
-    if (g == group_rotation.size()) {
-      group_rotation.push_back(r);
-      groups.emplace_back();
+    while (g < groups.size() && !(states[groups[g].front()].T_camera_lidar.linear() ==
+                                  states[n].T_camera_lidar.linear())) {
+      ++g;
     }
+    if (g == groups.size()) groups.emplace_back();
     groups[g].push_back(n);
   }
-  std::vector<ScoreValue> values(directions.size());
   double weight_sum = 0;
-  std::vector<Eigen::Vector3d> b(directions.size());
-  std::vector<double> depth_offset(directions.size());
+  std::vector<Eigen::Vector3d> b(states.size());
+  std::vector<double> depth_offset(states.size());
   for (size_t f = 0; f < frames_.size(); ++f) {
     const CalibrationFrame& cf = *frames_[f];
     const int maps_count = static_cast<int>(cf.score_maps[0].size());
@@ -202,17 +198,17 @@ std::vector<ScoreValue> WindowScorer::EvaluateNeighbours(
     CHECK(l >= 0 && l < maps_count && l < static_cast<int>(cf.score_maps[1].size()))
         << "score level " << level << " of " << maps_count;
     const cv::Mat* maps[2] = {&cf.score_maps[0][l], &cf.score_maps[1][l]};
-    const std::vector<Eigen::Vector3d>& moved = Moved(f, state.time_offset_s);
+    const std::vector<Eigen::Vector3d>& moved = Moved(f, states[0].time_offset_s);
     for (size_t k = 0; k < moved.size(); ++k) weight_sum += weights_[f][k];
     // As EvaluateOn: h = M·p + b, depth = depth_row·p + depth_offset.
     const Eigen::Matrix3d KR = cf.camera.P_rect_02.leftCols<3>() * cf.camera.R_rect_00;
-    for (size_t n = 0; n < neighbours.size(); ++n) {
-      const Rigid3d& T = neighbours[n].T_camera_lidar;
+    for (size_t n = 0; n < states.size(); ++n) {
+      const Rigid3d& T = states[n].T_camera_lidar;
       b[n] = KR * T.translation() + cf.camera.P_rect_02.col(3);
       depth_offset[n] = cf.camera.R_rect_00.row(2).dot(T.translation());
     }
     for (const std::vector<size_t>& group : groups) {
-      const Eigen::Matrix3d& R = neighbours[group.front()].T_camera_lidar.linear();
+      const Eigen::Matrix3d& R = states[group.front()].T_camera_lidar.linear();
       const Eigen::Matrix3d M = KR * R;
       const Eigen::Vector3d depth_row = cf.camera.R_rect_00.row(2) * R;
       for (size_t k = 0; k < moved.size(); ++k) {
@@ -260,8 +256,12 @@ double HealthScore(WindowScorer* scorer, const CalibrationState& state, double r
   const double centre = scorer->Evaluate(state, -1).score;
   double best = -std::numeric_limits<double>::infinity();
   int worse = 0, total = 0;
-  for (const ScoreValue& neighbour : scorer->EvaluateNeighbours(
-           state, rotation_deg * M_PI / 180.0, translation_m, NeighbourDirections(true), -1)) {
+  const double r = rotation_deg * M_PI / 180.0;
+  std::vector<CalibrationState> neighbours;
+  for (const Eigen::Matrix<double, 6, 1>& d : NeighbourDirections(true)) {
+    neighbours.push_back(Step(state, r * d.head<3>(), translation_m * d.tail<3>(), 0.0));
+  }
+  for (const ScoreValue& neighbour : scorer->EvaluateStates(neighbours, -1)) {
     worse += neighbour.score < centre;
     best = std::max(best, neighbour.score);
     ++total;

@@ -38,12 +38,10 @@ class WindowScorer {
   size_t num_frames() const { return frames_.size(); }
   const CalibrationFrame& frame(size_t f) const { return *frames_[f]; }
   const ScoreOptions& options() const { return options_; }
-  // Evaluate() of each neighbour Step(state, rotation_rad·d.head<3>(), translation_m·d.tail<3>(),
-  // 0) for d in `directions`, bit for bit: the neighbours that share a rotation share its
-  // projection products, so a 728-neighbourhood costs about half of 728 Evaluate() calls.
-  std::vector<ScoreValue> EvaluateNeighbours(
-      const CalibrationState& state, double rotation_rad, double translation_m,
-      const std::vector<Eigen::Matrix<double, 6, 1>>& directions, int level);
+  // Evaluate() of each of `states` (all at one δ), bit for bit: states with the same rotation
+  // share its projection products, so a 728-neighbourhood (27 rotations) costs about half of 728
+  // Evaluate() calls.
+  std::vector<ScoreValue> EvaluateStates(const std::vector<CalibrationState>& states, int level);
   // Evaluate() on frame `f` alone. The window's score is the sum of these in frame order up to
   // rounding (Evaluate() accumulates point by point across frames).
   ScoreValue EvaluateFrame(size_t f, const CalibrationState& state, int level);

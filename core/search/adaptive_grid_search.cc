@@ -76,16 +76,22 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
       const double trans = large ? options.alpha2_translation_m : options.alpha4_translation_m;
       double best = current;
       Eigen::Matrix<double, 6, 1> best_dir = Eigen::Matrix<double, 6, 1>::Zero();
-      const std::vector<ScoreValue> values =
-          scorer->EvaluateNeighbours(state, rot, trans, directions, level);
+      // The neighbours within the bounds, scored in one pass.
+      std::vector<CalibrationState> candidates;
+      std::vector<size_t> direction_of;
       for (size_t n = 0; n < directions.size(); ++n) {
         const Eigen::Matrix<double, 6, 1>& d = directions[n];
-        const CalibrationState candidate = Step(state, rot * d.head<3>(), trans * d.tail<3>(), 0.0);
+        CalibrationState candidate = Step(state, rot * d.head<3>(), trans * d.tail<3>(), 0.0);
         if (!WithinBounds(candidate, anchor, options)) continue;
-        const double s = objective_of(candidate, values[n]);
+        candidates.push_back(std::move(candidate));
+        direction_of.push_back(n);
+      }
+      const std::vector<ScoreValue> values = scorer->EvaluateStates(candidates, level);
+      for (size_t c = 0; c < candidates.size(); ++c) {
+        const double s = objective_of(candidates[c], values[c]);
         if (s > best) {
           best = s;
-          best_dir = d;
+          best_dir = directions[direction_of[c]];
         }
       }
       result.evaluations += directions.size();
