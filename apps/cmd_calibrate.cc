@@ -136,6 +136,7 @@ CalibrateJob CalibrateJobFromFlags() {
   o.refine.max_points_per_frame = FLAGS_max_points_per_frame;
   o.refine_frames = FLAGS_refine_frames;
   o.tracking_gain = FLAGS_tracking_gain;
+  o.tracking_update_every = FLAGS_tracking_update_every;
   o.refine.observable_rotation_deg = FLAGS_observable_rotation_deg;
   o.refine.observable_translation_m = FLAGS_observable_translation_m;
   o.refine.observable_time_s = FLAGS_observable_time_s;
@@ -228,7 +229,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
           PerturbTcameraLidar(disturbed.T_camera_lidar, d, Eigen::Vector3d::Zero());
       calibrator.SetState(disturbed);
     }
-    FrameReport report = calibrator.AddFrame(frame);
+    // The last frame updates: the verdict reads its refinement.
+    FrameReport report = calibrator.AddFrame(frame, /*update_now=*/i == last);
     frame_ms_sum +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!report.skipped) {
@@ -298,8 +300,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const FrameReport& final_report = outcome->polish.accepted ? outcome->polish : *final_report_ptr;
   const int skipped = verdict.skipped_frames;
   const std::vector<std::string>& unobservable = verdict.unobservable_axes;
-  // The covariance is the last frame's refinement's (the polish holds the translation).
-  const RefineResult& refine = final_report_ptr->refine;
+  // The covariance is the last update's refinement's (the polish holds the translation).
+  const FrameReport* last_update = LastUpdateReport(outcome->reports);
+  const RefineResult& refine = (last_update != nullptr ? last_update : final_report_ptr)->refine;
 
   // Outputs.
   const std::string out = job.out_dir;

@@ -42,6 +42,7 @@ DECLARE_double(prior_sigma_time_s);
 DECLARE_int32(refine_frames);
 DECLARE_int32(max_points_per_frame);
 DECLARE_double(tracking_gain);
+DECLARE_int32(tracking_update_every);
 DECLARE_double(observable_rotation_deg);
 DECLARE_double(observable_translation_m);
 DECLARE_double(observable_time_s);

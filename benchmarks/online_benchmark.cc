@@ -174,7 +174,9 @@ void BM_WholeFrame(benchmark::State& state) {
   if (!DriveFrameSource::Create(&Kitti().drive, CalibrateSourceOptions(), &source).ok()) {
     return state.SkipWithError("frame source");
   }
-  OnlineCalibrator calibrator(OnlineCalibratorOptions(), initial);
+  OnlineCalibratorOptions options;
+  options.tracking_update_every = static_cast<int>(state.range(0));
+  OnlineCalibrator calibrator(options, initial);
   double camera_time_s = 0;
   for (size_t i = 0; i < kFirstTimed; ++i) {
     auto frame = std::make_shared<CalibrationFrame>();
@@ -195,10 +197,12 @@ void BM_WholeFrame(benchmark::State& state) {
     next = next + 1 < Kitti().drive.NumFrames() ? next + 1 : kFirstTimed;
   }
   state.SetLabel(
-      "features + update, refine over 20 frames" +
+      "features + update every " + std::to_string(options.tracking_update_every) +
+      " frame(s) while tracking, refine over 20 frames" +
       (coarse > 0 ? ", " + std::to_string(coarse) + " coarse (acquiring or lost)" : std::string()));
 }
-BENCHMARK(BM_WholeFrame)->Unit(benchmark::kMillisecond);
+// Arg: tracking_update_every (3, the default; 1, an update on every frame).
+BENCHMARK(BM_WholeFrame)->Arg(3)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // Image features, LiDAR features and local map for one new frame (sweeps before it cached).
 void BM_FrameFeatures(benchmark::State& state) {

@@ -366,6 +366,55 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
               calibrator.state().T_camera_lidar.matrix());
   EXPECT_EQ(finest_only.state().time_offset_s, calibrator.state().time_offset_s);
 
+  // Tracking cadence (tracking_update_every, default 3): once acquired, a healthy frame runs the
+  // search and refinement on every third frame only, the frames between join the window and
+  // keep the estimate; a disturbance (SetState) and `update_now` update at once. Replayed frames,
+  // restamped.
+  {
+    ASSERT_EQ(online_options.tracking_update_every, 3);
+    ASSERT_FALSE(calibrator.acquiring());
+    OnlineCalibrator every_third = calibrator;
+    auto updated = [](const FrameReport& r) { return r.search.evaluations > 0; };
+    int updates = 0, in_a_row = 0, max_in_a_row = 0;
+    for (size_t k = 0; k < 9; ++k) {
+      auto again = std::make_shared<CalibrationFrame>(*frames[3 + k]);
+      again->camera_time_s += 20.0;
+      const FrameReport r = every_third.AddFrame(again);
+      if (updated(r)) {
+        ++updates;
+        in_a_row = 0;
+      } else {
+        EXPECT_GE(r.health_before, online_options.lost_health);
+        EXPECT_NE(r.reason.find("tracking: healthy"), std::string::npos) << r.reason;
+        EXPECT_TRUE(r.after.T_camera_lidar.matrix() == r.before.T_camera_lidar.matrix());
+        max_in_a_row = std::max(max_in_a_row, ++in_a_row);
+      }
+    }
+    const double error_every_third =
+        ComputeCalibrationError(every_third.state(), truth).rotation_deg;
+    std::printf("tracking cadence: %d updates in 9 frames, %.3f deg from the truth\n", updates,
+                error_every_third);
+    EXPECT_GE(updates, 3);
+    EXPECT_LT(updates, 9);
+    EXPECT_LE(max_in_a_row, 2);
+    // Measured 0.39° (0.22° before the replay; 0.51° updating on every frame: tracking drifts to
+    // the refinement's optimum on these frames, roll-biased, see the disturbance below).
+    EXPECT_LT(error_every_third, 0.5);
+    // At once: the frame after a disturbance, and a frame asked to.
+    auto replay = [&](size_t k, double later_s) {
+      auto again = std::make_shared<CalibrationFrame>(*frames[k]);
+      again->camera_time_s += later_s;
+      return again;
+    };
+    every_third.SetState(
+        Step(every_third.state(), Eigen::Vector3d(0.2, 0, 0) * M_PI / 180.0,
+             Eigen::Vector3d::Zero(), 0.0));
+    EXPECT_TRUE(updated(every_third.AddFrame(replay(6, 30.0))));
+    for (size_t k = 7; k < 12; ++k) {
+      EXPECT_TRUE(updated(every_third.AddFrame(replay(k, 30.0), /*update_now=*/true))) << k;
+    }
+  }
+
   // The paper's protocol, short: a 2° disturbance on each axis (3.5°) of the running estimate;
   // the last frames again (restamped later) bring it back.
   const CalibrationState settled = calibrator.state();

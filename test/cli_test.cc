@@ -502,19 +502,32 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
             1.0);
 }
 
-// δ started 50 ms off and the δ scan switched off: the estimate ends on a side peak 3.95° from
-// KITTI's calibration that the profiles and the suppressed check let through (mean health 0.865,
-// limit 0.85); the last window's health (0.835) is under the calibrator's own lost_health (0.9),
-// and that refuses it. (With the scan, the default, this start ends "not converged" too.)
+// δ started 50 ms off and the δ scan switched off: the estimate ends on a side peak about 4°
+// from KITTI's calibration. The last window's health is under the calibrator's own lost_health
+// (0.9), and that alone refuses it: with an update on every frame the profiles and the
+// suppressed check let it through (mean health 0.865, limit 0.85) and the final health (0.835)
+// refused it; with updates every third frame while tracking (the default) the score over δ
+// refuses it first, and the final health (0.81) would as well. (With the scan, the default, this
+// start ends "not converged" too.)
 TEST(Cli, KittiSidePeakIsRefusedOnItsFinalHealth) {
   STCALIB_REQUIRE_KITTI();
   testing::ScopedTempDir tmp;
-  const std::string out = tmp.path() + "/out";
-  const RunResult r =
-      CalibrateKitti(out, "--seed=2 --perturb_time_s=0.05 --acquire_time_offset=false");
-  EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_THAT(r.output, HasSubstr("not converged: health"));
-  EXPECT_FALSE(std::filesystem::exists(out + "/calib_velo_to_cam.txt"));
+  for (const std::string every : {"1", "3"}) {
+    SCOPED_TRACE(every);
+    const std::string out = tmp.path() + "/out" + every;
+    const RunResult r =
+        CalibrateKitti(out, "--seed=2 --perturb_time_s=0.05 --acquire_time_offset=false "
+                            "--tracking_update_every=" + every);
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("not converged: "));
+    const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
+    EXPECT_GT(result["agreement_with_drive_calibration"]["rotation_deg"].get<double>(), 3.0);
+    EXPECT_LT(result["health"].get<double>(), 0.9) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out + "/calib_velo_to_cam.txt"));
+    if (every == "1") {
+      EXPECT_THAT(r.output, HasSubstr("not converged: health"));
+    }
+  }
 }
 
 // Twelve frames from frame 10: these frames prefer a side peak 3.5° off; before the grid has

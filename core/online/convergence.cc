@@ -8,6 +8,13 @@
 
 namespace stcalib {
 
+const FrameReport* LastUpdateReport(const std::vector<FrameReport>& reports) {
+  for (auto it = reports.rbegin(); it != reports.rend(); ++it) {
+    if (!it->skipped && it->search.evaluations > 0) return &*it;
+  }
+  return nullptr;
+}
+
 ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                                     const std::vector<FrameReport>& reports,
                                     const CalibrationState& initial,
@@ -37,6 +44,8 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   verdict.skipped_frames = static_cast<int>(reports.size() - used.size());
   const FrameReport empty_report;
   const FrameReport& last = used.empty() ? empty_report : *used.back();
+  const FrameReport* last_update_ptr = LastUpdateReport(reports);
+  const FrameReport& last_update = last_update_ptr != nullptr ? *last_update_ptr : last;
   // The online trajectory's own moves over the last settle_frames frames (a final polish is not a
   // frame): every estimate those frames started from or ended at lies within max_settle_deg of
   // the last. A jump in the first of them lands on a state the later frames merely keep (a KITTI
@@ -57,7 +66,7 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   std::string unobservable_text;
   for (int k = 0; k < kNumAxes; ++k) {
     if (k == 6 && !online.refine.estimate_time_offset) continue;
-    if (last.refine.observable[k]) continue;
+    if (last_update.refine.observable[k]) continue;
     verdict.unobservable_axes.push_back(kAxisNames[k]);
     unobservable_text += (unobservable_text.empty() ? "" : ", ") + std::string(kAxisNames[k]);
   }
@@ -68,7 +77,7 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   const bool at_rotation_bound =
       moved_deg >= online.search.max_rotation_offset_deg - options.rotation_bound_margin_deg;
   if (!used.empty() && !verdict.unobservable_axes.empty()) {
-    verdict.estimate = KeepObservableAxes(initial, verdict.estimate, last.refine.observable);
+    verdict.estimate = KeepObservableAxes(initial, verdict.estimate, last_update.refine.observable);
   }
 
   std::string profile_problem;
@@ -105,8 +114,7 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   } else if (last.points < options.min_points) {
     verdict.reason = "not converged: no usable features (" + std::to_string(last.points) +
                      " LiDAR edge points in the image)";
-  } else if (std::none_of(used.begin(), used.end(),
-                          [](const FrameReport* r) { return r->search.evaluations > 0; })) {
+  } else if (last_update_ptr == nullptr) {
     // Not even one update: say so, or the start would read as an estimate.
     verdict.reason =
         "not converged: none of the " + std::to_string(verdict.used_frames) +

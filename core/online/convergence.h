@@ -56,6 +56,10 @@ struct ConvergenceVerdict {
   int used_frames = 0, skipped_frames = 0;
 };
 
+// The last report that ran a search and a refinement (refused frames and tracking frames
+// between updates did not); nullptr when none did. Its refinement holds the latest covariance.
+const FrameReport* LastUpdateReport(const std::vector<FrameReport>& reports);
+
 // `reports` are all of the run's frame reports in order; `initial` the run's start.
 ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                                     const std::vector<FrameReport>& reports,

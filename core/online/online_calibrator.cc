@@ -32,6 +32,9 @@ CalibrationState KeepObservableAxes(const CalibrationState& old, const Calibrati
 
 Status OnlineCalibratorOptions::Validate() const {
   if (window_frames < 1) return Status::Error("online: window_frames must be >= 1");
+  if (tracking_update_every < 1) {
+    return Status::Error("online: tracking_update_every must be >= 1");
+  }
   if (!(horizontal_weight >= 0 && horizontal_weight <= 1)) {
     return Status::Error("online: horizontal_weight must be in [0, 1]");
   }
@@ -95,7 +98,8 @@ std::string OnlineCalibrator::RefusalReason(const CalibrationFrame& frame) const
   return "";
 }
 
-FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> frame) {
+FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> frame,
+                                       bool update_now) {
   const std::string why = RefusalReason(*frame);
   if (!why.empty()) return SkipFrame(frame->index, why);
   last_camera_time_s_ = frame->camera_time_s;
@@ -126,6 +130,20 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
     report.health = report.health_before;
     return report;
   }
+  const bool tracking = !acquiring() && report.health_before >= options_.lost_health &&
+                        static_cast<int>(frames.size()) >= options_.window_frames;
+  if (tracking && !update_now && ++frames_since_update_ < options_.tracking_update_every) {
+    report.reason = "tracking: healthy, next update in " +
+                    std::to_string(options_.tracking_update_every - frames_since_update_) +
+                    " frame(s): estimate kept";
+    report.score_after = report.score_before;
+    report.gray_rate_after = report.gray_rate_before;
+    report.health = report.health_before;
+    last_health_ = report.health;
+    return report;
+  }
+  frames_since_update_ = 0;
+  report.acquiring = acquiring();
   // Coarse-to-fine from the widest map when lost or while the window fills, else the finest map.
   report.coarse_search = report.health_before < options_.lost_health ||
                          (options_.coarse_until_window_full &&
@@ -300,11 +318,14 @@ void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowSc
   }
   // While tracking, move only part of the way (a first-order filter over frames): single windows
   // scatter, their average does not. A lost estimate jumps.
-  if (report->accepted && !report->coarse_search && options_.tracking_gain < 1.0) {
+  if (report->accepted && (!report->coarse_search || !report->acquiring) &&
+      options_.tracking_gain < 1.0) {
     const CalibrationState& c = report->after;
     const double g = options_.tracking_gain;
+    const double g_rotation = report->coarse_search ? 1.0 : g;
     report->after = Step(
-        state_, g * LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear()),
+        state_,
+        g_rotation * LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear()),
         g * (c.T_camera_lidar.translation() - state_.T_camera_lidar.translation()),
         g * (c.time_offset_s - state_.time_offset_s));
   }

@@ -70,6 +70,12 @@ struct OnlineCalibratorOptions {
   // estimate: a first-order filter that averages the scatter of single windows (on a street they
   // scatter by a few tenths of a degree).
   double tracking_gain = 0.3;
+  // While tracking (acquisition over, a full window, health at least lost_health), the search
+  // and refinement run on every n-th frame only; the frames between join the window and have
+  // their health measured, and a frame whose health falls below lost_health runs at once. With
+  // n = window_frames every frame lies in exactly one searched window and in every refinement
+  // that covers it: the same data, read once instead of n times. 1 = update on every frame.
+  int tracking_update_every = 3;
 
   // Whether the search reads the frames' coarse score levels (their pyramid): only without the
   // rotation grid (lost_grid_deg = 0), where a lost or filling window searches coarse to fine.
@@ -90,6 +96,7 @@ struct FrameReport {
   double health_before = 0;                          ///< method.md §7, at `before`
   double health = 0;                                 ///< method.md §7, at `after`
   bool coarse_search = false;
+  bool acquiring = false;  ///< the calibrator was still acquiring when the frame arrived
   SearchResult search;
   RefineResult refine;
   double search_ms = 0, refine_ms = 0;
@@ -116,7 +123,9 @@ class OnlineCalibrator {
 
   // A frame that cannot be used (stamp not after the last frame's, no image edges, non-finite
   // motion) is refused: the report says why and the estimate and window stay as they were.
-  FrameReport AddFrame(std::shared_ptr<const CalibrationFrame> frame);
+  // `update_now`: search and refine on this frame whatever tracking_update_every says (a run's
+  // last frame, whose refinement the final verdict reads).
+  FrameReport AddFrame(std::shared_ptr<const CalibrationFrame> frame, bool update_now = false);
   // A frame the caller could not load: recorded as skipped with `why`.
   FrameReport SkipFrame(int frame, const std::string& why) const;
   const CalibrationState& state() const { return state_; }
@@ -140,7 +149,11 @@ class OnlineCalibrator {
   // refinement fails or leaves the bounds; the report says what happened.
   FrameReport Polish();
   // Replaces the estimate (the paper's disturbance protocol); the bounds stay where they were.
-  void SetState(const CalibrationState& state) { state_ = state; }
+  // The next frame updates whatever tracking_update_every says.
+  void SetState(const CalibrationState& state) {
+    state_ = state;
+    frames_since_update_ = options_.tracking_update_every;
+  }
   // The frames the last search used (the latest window_frames).
   std::vector<const CalibrationFrame*> SearchWindow() const;
   // The frames the last refinement used (the latest refine_frames), oldest first.
@@ -183,6 +196,7 @@ class OnlineCalibrator {
   // is lost, a search from there is a candidate too (a disturbance or a wrong jump).
   bool has_last_healthy_ = false;
   double last_health_ = 0;  ///< health after the last updated frame
+  int frames_since_update_ = 0;  ///< tracking frames since the last search and refinement
   CalibrationState last_healthy_;
   std::deque<std::shared_ptr<const CalibrationFrame>> window_;  // the last refine_frames frames
   // The rotation grid's per-frame scores: while acquiring the grid runs on a window that grows
