@@ -245,7 +245,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       const CalibrationError er =
           ComputeCalibrationError(report.refine.state, outcome->reference_state);
       VLOG(1) << "frame " << i << ": search " << ToString(es) << " | refine (usable "
-              << report.refine.usable << ") " << ToString(er) << " | " << report.reason;
+              << report.refine.usable << ", " << report.refine.iterations << " iterations, "
+              << report.refine.residuals << " residuals) " << ToString(er) << " | "
+              << report.reason;
     }
     if (job.progress) {
       const CalibrationError e = ComputeCalibrationError(report.after, outcome->reference_state);
