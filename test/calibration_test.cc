@@ -426,6 +426,26 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     again->camera_time_s += 10.0;
     const FrameReport r = calibrator.AddFrame(again);
     reasons.push_back(r.reason);
+    if (k == frames.size() - 3) {
+      // Lost after the acquisition: the rotation jumps to the chosen candidate, the translation
+      // and δ move by tracking_gain only.
+      EXPECT_TRUE(r.coarse_search);
+      EXPECT_FALSE(r.acquiring);
+      ASSERT_EQ(r.reason.rfind("refined", 0), 0u) << r.reason;
+      const CalibrationState chosen =
+          KeepObservableAxes(r.before, r.refine.state, r.refine.observable);
+      EXPECT_LT(RotationErrorDeg(r.after.T_camera_lidar.linear(), chosen.T_camera_lidar.linear()),
+                1e-9);
+      const Eigen::Vector3d moved =
+          r.after.T_camera_lidar.translation() - r.before.T_camera_lidar.translation();
+      const Eigen::Vector3d offered =
+          chosen.T_camera_lidar.translation() - r.before.T_camera_lidar.translation();
+      EXPECT_GT(offered.norm(), 1e-4);
+      EXPECT_LT((moved - online_options.tracking_gain * offered).norm(), 1e-12);
+      EXPECT_NEAR(r.after.time_offset_s - r.before.time_offset_s,
+                  online_options.tracking_gain * (chosen.time_offset_s - r.before.time_offset_s),
+                  1e-12);
+    }
     std::printf(
         "after the disturbance, frame %zu: %.3f deg from the settled estimate, %.3f deg "
         "from the truth (%s)\n",
