@@ -134,6 +134,7 @@ CalibrateJob CalibrateJobFromFlags() {
   o.refine.prior_sigma_forward_m = FLAGS_prior_sigma_forward_m;
   o.refine.prior_sigma_time_s = FLAGS_prior_sigma_time_s;
   o.refine.max_points_per_frame = FLAGS_max_points_per_frame;
+  o.refine.max_iterations = FLAGS_refine_max_iterations;
   o.refine_frames = FLAGS_refine_frames;
   o.tracking_gain = FLAGS_tracking_gain;
   o.tracking_update_every = FLAGS_tracking_update_every;

@@ -41,6 +41,7 @@ DECLARE_double(prior_sigma_forward_m);
 DECLARE_double(prior_sigma_time_s);
 DECLARE_int32(refine_frames);
 DECLARE_int32(max_points_per_frame);
+DECLARE_int32(refine_max_iterations);
 DECLARE_double(tracking_gain);
 DECLARE_int32(tracking_update_every);
 DECLARE_double(observable_rotation_deg);
