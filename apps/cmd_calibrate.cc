@@ -230,7 +230,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
           PerturbTcameraLidar(disturbed.T_camera_lidar, d, Eigen::Vector3d::Zero());
       calibrator.SetState(disturbed);
     }
-    // The last frame updates: the verdict reads its refinement.
+    // The last frame updates, so that the verdict reads a refinement over the latest frames (if
+    // it cannot be loaded, the verdict reads the last update's, at most
+    // tracking_update_every - 1 frames older).
     FrameReport report = calibrator.AddFrame(frame, /*update_now=*/i == last);
     frame_ms_sum +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -240,7 +242,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       ++frames_used;
     }
     outcome->reports.push_back(report);
-    if (VLOG_IS_ON(1)) {
+    if (VLOG_IS_ON(1) && report.ran_update()) {
       const CalibrationError es =
           ComputeCalibrationError(report.search.state, outcome->reference_state);
       const CalibrationError er =
@@ -329,6 +331,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     observable_json[kAxisNames[k]] = refine.observable[k];
   }
   const Eigen::Vector3d rpy_deg = EulerRpyDeg(outcome->estimate.T_camera_lidar.linear());
+  // Per frame, over all frames (those without an update count as 0 ms).
   double search_ms = 0, refine_ms = 0;
   for (const FrameReport& r : outcome->reports) {
     search_ms += r.search_ms / outcome->reports.size();

@@ -65,6 +65,7 @@ void BM_OnlineUpdate(benchmark::State& state) {
   const CalibrationState initial = KittiCalibration();
   OnlineCalibratorOptions options;
   options.refine_frames = static_cast<int>(state.range(0));
+  options.tracking_update_every = 1;  // one update per iteration
   OnlineCalibrator calibrator(options, initial);
   // Warm up on every loaded frame: the acquisition (rotation grid on each frame) ends once the
   // grid agrees with the estimate on a full refinement window; from then on it tracks.
@@ -162,7 +163,8 @@ void BM_Refine(benchmark::State& state) {
 BENCHMARK(BM_Refine)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
 
 // The whole per-frame path with the defaults (20-frame refinement): image and LiDAR features
-// with the local map, then the online update, for each new frame of the drive while tracking.
+// with the local map, then the online calibrator (an update on every n-th frame while tracking,
+// n the benchmark's argument), for each new frame of the drive.
 // The calibrator first runs through frames 0-21 (its acquisition ends within them); frames 22-29
 // then cycle, restamped so that they keep arriving in time order.
 void BM_WholeFrame(benchmark::State& state) {

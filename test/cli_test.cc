@@ -504,12 +504,12 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
 
 // δ started 50 ms off and the δ scan switched off: the estimate ends on a side peak about 4°
 // from KITTI's calibration. The last window's health is under the calibrator's own lost_health
-// (0.9), and that alone refuses it: with an update on every frame the profiles and the
+// (0.9), and that alone would refuse it: with an update on every frame the profiles and the
 // suppressed check let it through (mean health 0.865, limit 0.85) and the final health (0.835)
 // refused it; with updates every third frame while tracking (the default) the score over δ
 // refuses it first, and the final health (0.81) would as well. (With the scan, the default, this
 // start ends "not converged" too.)
-TEST(Cli, KittiSidePeakIsRefusedOnItsFinalHealth) {
+TEST(Cli, KittiSidePeakIsRefused) {
   STCALIB_REQUIRE_KITTI();
   testing::ScopedTempDir tmp;
   for (const std::string every : {"1", "3"}) {
@@ -524,9 +524,8 @@ TEST(Cli, KittiSidePeakIsRefusedOnItsFinalHealth) {
     EXPECT_GT(result["agreement_with_drive_calibration"]["rotation_deg"].get<double>(), 3.0);
     EXPECT_LT(result["health"].get<double>(), 0.9) << r.output;
     EXPECT_FALSE(std::filesystem::exists(out + "/calib_velo_to_cam.txt"));
-    if (every == "1") {
-      EXPECT_THAT(r.output, HasSubstr("not converged: health"));
-    }
+    EXPECT_THAT(r.output, HasSubstr(every == "1" ? "not converged: health"
+                                                 : "not converged: the last frames' score over δ"));
   }
 }
 

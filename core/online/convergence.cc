@@ -10,7 +10,7 @@ namespace stcalib {
 
 const FrameReport* LastUpdateReport(const std::vector<FrameReport>& reports) {
   for (auto it = reports.rbegin(); it != reports.rend(); ++it) {
-    if (!it->skipped && it->search.evaluations > 0) return &*it;
+    if (!it->skipped && it->ran_update()) return &*it;
   }
   return nullptr;
 }
@@ -46,16 +46,21 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   const FrameReport& last = used.empty() ? empty_report : *used.back();
   const FrameReport* last_update_ptr = LastUpdateReport(reports);
   const FrameReport& last_update = last_update_ptr != nullptr ? *last_update_ptr : last;
-  // The online trajectory's own moves over the last settle_frames frames (a final polish is not a
-  // frame): every estimate those frames started from or ended at lies within max_settle_deg of
-  // the last. A jump in the first of them lands on a state the later frames merely keep (a KITTI
-  // run jumped 3° to a side peak two frames before its end).
+  // The online trajectory's own moves over its last settle_frames updates (frames between
+  // updates keep the estimate; a final polish is not a frame): every estimate those updates
+  // started from or ended at lies within max_settle_deg of the last. A jump in the first of them
+  // lands on a state the later frames merely keep (a KITTI run jumped 3° to a side peak two
+  // frames before its end).
+  std::vector<const FrameReport*> updates;
+  for (const FrameReport* r : used) {
+    if (r->ran_update()) updates.push_back(r);
+  }
   double settle_deg = 0;
-  for (size_t k = used.size() >= static_cast<size_t>(options.settle_frames)
-                      ? used.size() - options.settle_frames
+  for (size_t k = updates.size() >= static_cast<size_t>(options.settle_frames)
+                      ? updates.size() - options.settle_frames
                       : 0;
-       k < used.size(); ++k) {
-    for (const CalibrationState* state : {&used[k]->before, &used[k]->after}) {
+       k < updates.size(); ++k) {
+    for (const CalibrationState* state : {&updates[k]->before, &updates[k]->after}) {
       settle_deg = std::max(settle_deg, RotationErrorDeg(state->T_camera_lidar.linear(),
                                                          last.after.T_camera_lidar.linear()));
     }

@@ -15,9 +15,9 @@ namespace stcalib {
 struct ConvergenceOptions {
   int min_points = 30;    ///< LiDAR edge points in the last window
   int min_frames = 3;     ///< used frames needed to see the estimate settle
-  int settle_frames = 3;  ///< the estimate's last moves are judged over these
-  // Every estimate the last settle_frames frames started from or ended at lies this close to the
-  // final one [deg].
+  int settle_frames = 3;  ///< the estimate's last moves are judged over this many updates
+  // Every estimate the last settle_frames updates (frames that ran a search) started from or
+  // ended at lies this close to the final one [deg].
   double max_settle_deg = 0.3;
   // Health of the last window at the estimate: at least the calibrator's own lost_health (an
   // estimate it would search away from is not converged). Measured: converged runs end at

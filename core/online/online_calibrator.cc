@@ -58,6 +58,7 @@ OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
   state_.time_offset_s =
       std::clamp(state_.time_offset_s, -options_.time_offset_bound_s, options_.time_offset_bound_s);
   anchor_ = state_;
+  frames_since_update_ = options_.tracking_update_every;
 }
 
 std::vector<const CalibrationFrame*> OnlineCalibrator::SearchWindow() const {
@@ -124,24 +125,19 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   report.gray_rate_before = scorer.GrayRate(state_);
   report.health_before = HealthScore(&scorer, state_);
   if (options_.wait_for_full_window && static_cast<int>(frames.size()) < options_.window_frames) {
-    report.reason = "window filling (" + std::to_string(frames.size()) + " of " +
-                    std::to_string(options_.window_frames) + " frames): estimate kept";
-    report.score_after = report.score_before;
-    report.gray_rate_after = report.gray_rate_before;
-    report.health = report.health_before;
-    return report;
+    return KeepEstimate(report, "window filling (" + std::to_string(frames.size()) + " of " +
+                                    std::to_string(options_.window_frames) +
+                                    " frames): estimate kept");
   }
   const bool tracking = !acquiring() && report.health_before >= options_.lost_health &&
                         static_cast<int>(frames.size()) >= options_.window_frames;
   if (tracking && !update_now && ++frames_since_update_ < options_.tracking_update_every) {
-    report.reason = "tracking: healthy, next update in " +
-                    std::to_string(options_.tracking_update_every - frames_since_update_) +
-                    " frame(s): estimate kept";
-    report.score_after = report.score_before;
-    report.gray_rate_after = report.gray_rate_before;
-    report.health = report.health_before;
-    last_health_ = report.health;
-    return report;
+    has_last_healthy_ = true;
+    last_healthy_ = state_;
+    return KeepEstimate(report, "tracking: healthy, next update in " +
+                                    std::to_string(options_.tracking_update_every -
+                                                   frames_since_update_) +
+                                    " frame(s): estimate kept");
   }
   frames_since_update_ = 0;
   // Coarse-to-fine from the widest map when lost or while the window fills, else the finest map.
@@ -204,6 +200,14 @@ FrameReport OnlineCalibrator::Polish() {
   // On the search window, like a frame's.
   WindowScorer scorer(SearchWindow(), options_.score);
   MeasureEstimate(&scorer, true, &report);
+  return report;
+}
+
+FrameReport OnlineCalibrator::KeepEstimate(FrameReport report, const std::string& reason) {
+  report.reason = reason;
+  report.score_after = report.score_before;
+  report.gray_rate_after = report.gray_rate_before;
+  report.health = last_health_ = report.health_before;
   return report;
 }
 
@@ -317,11 +321,12 @@ void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowSc
     report->reason = candidate.name;
   }
   // While tracking, move only part of the way (a first-order filter over frames): single windows
-  // scatter, their average does not. A lost estimate jumps, in rotation only once acquired: the
-  // translation and δ were estimated over the acquisition's frames, a lost window is suspect,
-  // and a KITTI run's lost window at frame 28 moved the translation 5 cm with a full jump.
-  if (report->accepted && (!report->coarse_search || !report->acquiring) &&
-      options_.tracking_gain < 1.0) {
+  // scatter, their average does not. A lost estimate jumps, in rotation only once acquired (and
+  // healthy once): the translation and δ were estimated over the acquisition's frames, a lost
+  // window is suspect, and a KITTI run's lost window at frame 28 moved the translation 5 cm with a
+  // full jump.
+  const bool acquired = !report->acquiring && has_last_healthy_;
+  if (report->accepted && (!report->coarse_search || acquired) && options_.tracking_gain < 1.0) {
     const CalibrationState& c = report->after;
     const double g = options_.tracking_gain;
     const double g_rotation = report->coarse_search ? 1.0 : g;

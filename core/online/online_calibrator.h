@@ -66,8 +66,8 @@ struct OnlineCalibratorOptions {
   double acquire_time_offset_keep_ratio = 0.9;
   // When lost, also search from the last healthy estimate and offer the result as a candidate.
   bool search_from_last_healthy = true;
-  // While tracking (not lost), an accepted update moves this share of the way to the new
-  // estimate: a first-order filter that averages the scatter of single windows (on a street they
+  // While tracking (not lost; once acquired, a lost update's translation and δ too), an accepted
+  // update moves this share of the way to the new estimate: a first-order filter that averages the scatter of single windows (on a street they
   // scatter by a few tenths of a degree).
   double tracking_gain = 0.3;
   // While tracking (acquisition over, a full window, health at least lost_health), the search
@@ -101,6 +101,9 @@ struct FrameReport {
   RefineResult refine;
   double search_ms = 0, refine_ms = 0;
   int points = 0;
+  // Whether this frame ran the search and refinement (refused, window-filling frames and tracking
+  // frames between updates do not).
+  bool ran_update() const { return search.evaluations > 0; }
 };
 
 // `candidate` on its observable axes, `old` on the others (rotation about the LiDAR axes,
@@ -108,8 +111,8 @@ struct FrameReport {
 CalibrationState KeepObservableAxes(const CalibrationState& old, const CalibrationState& candidate,
                                     const std::array<bool, kNumAxes>& observable);
 
-// Online calibration (method.md §7): frames in time order; per frame a search step and a refine
-// over the window; an update is taken only when the window score does not get worse and the axes
+// Online calibration (method.md §7): frames in time order; per frame (once acquired, per
+// tracking_update_every frames while healthy) a search step and a refine over the window; an update is taken only when the window score does not get worse and the axes
 // it moves are observable (an unobservable axis keeps its value); |δ| stays within its bound.
 // It only sequences the stages; the maths lives in score/, search/ and refine/.
 // `options` with its shared settings (horizontal_weight, time_offset_bound_s) copied into score,
@@ -140,7 +143,7 @@ class OnlineCalibrator {
   }
   // The final step of a run: refines the rotation over the latest refine_frames frames from the
   // estimate, translation and δ held. While tracking, the estimate moves only tracking_gain of
-  // the way per frame and each move is judged on the score map, whose peak can sit a few tenths
+  // the way per update and each move is judged on the score map, whose peak can sit a few tenths
   // of a degree from the refinement's optimum: the search is for finding the peak, the
   // refinement for where on it (KITTI from 1-3 deg starts: 0.25-0.63 deg without, 0.24-0.32
   // with). The translation stays because edges pin it down only to a few cm (a free one moved
@@ -154,9 +157,9 @@ class OnlineCalibrator {
     state_ = state;
     frames_since_update_ = options_.tracking_update_every;
   }
-  // The frames the last search used (the latest window_frames).
+  // The latest window_frames frames (what a search on the latest frame reads).
   std::vector<const CalibrationFrame*> SearchWindow() const;
-  // The frames the last refinement used (the latest refine_frames), oldest first.
+  // The latest refine_frames frames (what a refinement on the latest frame reads), oldest first.
   std::vector<std::shared_ptr<const CalibrationFrame>> RecentFrames() const {
     return {window_.begin(), window_.end()};
   }
@@ -181,12 +184,16 @@ class OnlineCalibrator {
                                     const AdaptiveGridSearchOptions& search_options,
                                     FrameReport* report) const;
   // The best candidate within the bounds that scores at least as well as the estimate on the
-  // refinement's frames, moved by tracking_gain while tracking: fills report->after.
+  // refinement's frames, moved by tracking_gain while tracking (after the acquisition, a lost
+  // update's translation and δ too): fills report->after.
   void Choose(const std::vector<Candidate>& candidates, WindowScorer* long_scorer,
               const AdaptiveGridSearchOptions& search_options, FrameReport* report) const;
 
   // Score, gray rate and health at the estimate (health_before reused when it did not move).
   void MeasureEstimate(WindowScorer* scorer, bool moved, FrameReport* report);
+  // A frame without an update (window filling, tracking between updates): the estimate and its
+  // measures stay, `reason` says why.
+  FrameReport KeepEstimate(FrameReport report, const std::string& reason);
 
   OnlineCalibratorOptions options_;
   CalibrationState state_;
@@ -195,8 +202,9 @@ class OnlineCalibrator {
   // The latest estimate whose health reached lost_health after a full window: when the estimate
   // is lost, a search from there is a candidate too (a disturbance or a wrong jump).
   bool has_last_healthy_ = false;
-  double last_health_ = 0;  ///< health after the last updated frame
-  int frames_since_update_ = 0;  ///< tracking frames since the last search and refinement
+  double last_health_ = 0;  ///< health at the estimate on the latest window
+  // Tracking frames since the last search and refinement (starts due: the first updates).
+  int frames_since_update_ = 0;
   CalibrationState last_healthy_;
   std::deque<std::shared_ptr<const CalibrationFrame>> window_;  // the last refine_frames frames
   // The rotation grid's per-frame scores: while acquiring the grid runs on a window that grows
