@@ -71,6 +71,7 @@ std::vector<const CalibrationFrame*> OnlineCalibrator::SearchWindow() const {
 FrameReport OnlineCalibrator::SkipFrame(int frame, const std::string& why) const {
   FrameReport report;
   report.frame = frame;
+  report.acquiring = acquiring();
   report.before = report.after = state_;
   report.skipped = true;
   report.reason = "frame skipped: " + why + "; estimate kept";
