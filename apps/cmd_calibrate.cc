@@ -305,9 +305,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const FrameReport& final_report = outcome->polish.accepted ? outcome->polish : *final_report_ptr;
   const int skipped = verdict.skipped_frames;
   const std::vector<std::string>& unobservable = verdict.unobservable_axes;
-  // The covariance is the last update's refinement's (the polish holds the translation).
-  const FrameReport* last_update = LastUpdateReport(outcome->reports);
-  const RefineResult& refine = (last_update != nullptr ? last_update : final_report_ptr)->refine;
+  // The covariance is the refinement the verdict read (the polish holds the translation).
+  const RefineResult& refine = verdict.refine;
 
   // Outputs.
   const std::string out = job.out_dir;

@@ -8,13 +8,6 @@
 
 namespace stcalib {
 
-const FrameReport* LastUpdateReport(const std::vector<FrameReport>& reports) {
-  for (auto it = reports.rbegin(); it != reports.rend(); ++it) {
-    if (!it->skipped && it->ran_update()) return &*it;
-  }
-  return nullptr;
-}
-
 ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                                     const std::vector<FrameReport>& reports,
                                     const CalibrationState& initial,
@@ -44,8 +37,6 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   verdict.skipped_frames = static_cast<int>(reports.size() - used.size());
   const FrameReport empty_report;
   const FrameReport& last = used.empty() ? empty_report : *used.back();
-  const FrameReport* last_update_ptr = LastUpdateReport(reports);
-  const FrameReport& last_update = last_update_ptr != nullptr ? *last_update_ptr : last;
   // The online trajectory's own moves over its last settle_frames updates (frames between
   // updates keep the estimate; a final polish is not a frame): every estimate those updates
   // started from or ended at lies within max_settle_deg of the last. A jump in the first of them
@@ -55,6 +46,8 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   for (const FrameReport* r : used) {
     if (r->ran_update()) updates.push_back(r);
   }
+  const FrameReport& last_update = updates.empty() ? last : *updates.back();
+  verdict.refine = last_update.refine;
   double settle_deg = 0;
   for (size_t k = updates.size() >= static_cast<size_t>(options.settle_frames)
                       ? updates.size() - options.settle_frames
@@ -119,7 +112,7 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   } else if (last.points < options.min_points) {
     verdict.reason = "not converged: no usable features (" + std::to_string(last.points) +
                      " LiDAR edge points in the image)";
-  } else if (last_update_ptr == nullptr) {
+  } else if (updates.empty()) {
     // Not even one update: say so, or the start would read as an estimate.
     verdict.reason =
         "not converged: none of the " + std::to_string(verdict.used_frames) +

@@ -54,11 +54,10 @@ struct ConvergenceVerdict {
   bool health_checked = false;
   HealthCheckResult health_check;  ///< on the suppressed maps (when checked)
   int used_frames = 0, skipped_frames = 0;
+  // The refinement the verdict read the axes' observability from: the last update's (refused
+  // frames and tracking frames between updates run none), with its per-axis std and correlations.
+  RefineResult refine;
 };
-
-// The last report that ran a search and a refinement (refused frames and tracking frames
-// between updates did not); nullptr when none did. Its refinement holds the latest covariance.
-const FrameReport* LastUpdateReport(const std::vector<FrameReport>& reports);
 
 // `reports` are all of the run's frame reports in order; `initial` the run's start.
 ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,

@@ -133,8 +133,7 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   const bool tracking = !acquiring() && report.health_before >= options_.lost_health &&
                         static_cast<int>(frames.size()) >= options_.window_frames;
   if (tracking && !update_now && ++frames_since_update_ < options_.tracking_update_every) {
-    has_last_healthy_ = true;
-    last_healthy_ = state_;
+    RememberIfHealthy(report.health_before, frames.size());
     return KeepEstimate(report, "tracking: healthy, next update in " +
                                     std::to_string(options_.tracking_update_every -
                                                    frames_since_update_) +
@@ -159,11 +158,7 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   Choose(Candidates(&scorer, search_options, &report), &long_scorer, search_options, &report);
   state_ = report.after;
   MeasureEstimate(&scorer, report.accepted, &report);
-  if (report.health >= options_.lost_health &&
-      static_cast<int>(frames.size()) >= options_.window_frames) {
-    has_last_healthy_ = true;
-    last_healthy_ = state_;
-  }
+  RememberIfHealthy(report.health, frames.size());
   return report;
 }
 
@@ -202,6 +197,13 @@ FrameReport OnlineCalibrator::Polish() {
   WindowScorer scorer(SearchWindow(), options_.score);
   MeasureEstimate(&scorer, true, &report);
   return report;
+}
+
+void OnlineCalibrator::RememberIfHealthy(double health, size_t window_size) {
+  if (health >= options_.lost_health && static_cast<int>(window_size) >= options_.window_frames) {
+    has_last_healthy_ = true;
+    last_healthy_ = state_;
+  }
 }
 
 FrameReport OnlineCalibrator::KeepEstimate(FrameReport report, const std::string& reason) {

@@ -194,6 +194,8 @@ class OnlineCalibrator {
   // A frame without an update (window filling, tracking between updates): the estimate and its
   // measures stay, `reason` says why.
   FrameReport KeepEstimate(FrameReport report, const std::string& reason);
+  // The estimate becomes the last healthy one when `health` reaches lost_health on a full window.
+  void RememberIfHealthy(double health, size_t window_size);
 
   OnlineCalibratorOptions options_;
   CalibrationState state_;
