@@ -20,6 +20,10 @@ int RunSimulate() {
     return UsageError("simulate",
                       "--scene must be urban, poles or open, got '" + FLAGS_scene + "'");
   }
+  if (!sim::ParseSimCamera(FLAGS_camera, &options.camera)) {
+    return UsageError("simulate",
+                      "--camera must be kitti, kitti_1003 or hd720, got '" + FLAGS_camera + "'");
+  }
   const Status valid = options.Validate();
   if (!valid.ok()) return UsageError("simulate", valid.message());
 
@@ -34,11 +38,11 @@ int RunSimulate() {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf(
-      "simulated %d frames (scene %s, seed %llu, time offset %+.4f s, %d moving objects) "
-      "in %.1f s\ndrive: %s\n",
+      "simulated %d frames (scene %s, camera %s, seed %llu, time offset %+.4f s, %d moving "
+      "objects) in %.1f s\ndrive: %s\n",
       options.frames, sim::SceneTypeName(options.scene).c_str(),
-      static_cast<unsigned long long>(options.seed), options.time_offset_s, options.dynamic_objects,
-      seconds, drive_dir.c_str());
+      sim::SimCameraName(options.camera).c_str(), static_cast<unsigned long long>(options.seed),
+      options.time_offset_s, options.dynamic_objects, seconds, drive_dir.c_str());
   return kExitOk;
 }
 

@@ -16,6 +16,9 @@ DEFINE_double(time_offset_s, 0.0,
               "simulate: true time offset δ [s]; LiDAR stamps are the true time minus δ");
 DEFINE_int32(dynamic_objects, 6, "simulate: moving vehicles and pedestrians");
 DEFINE_string(scene, "urban", "simulate: urban | poles (vertical structures only) | open");
+DEFINE_string(camera, "kitti",
+              "simulate: kitti (1242x375) | kitti_1003 (1241x376) | hd720 (1280x720, 3 deg "
+              "nose-down)");
 DEFINE_double(lidar_hz, 10.0, "simulate: LiDAR spin rate = frame rate of every sensor [Hz]");
 DEFINE_string(detector, "canny", "image edges: canny | lsd | fld (cv::ximgproc FastLineDetector)");
 DEFINE_double(min_segment_px, 15, "lsd/fld: shorter segments are dropped as texture [px]");

@@ -13,6 +13,7 @@ DECLARE_uint64(seed);
 DECLARE_double(time_offset_s);
 DECLARE_int32(dynamic_objects);
 DECLARE_string(scene);
+DECLARE_string(camera);
 DECLARE_double(lidar_hz);
 DECLARE_string(detector);
 DECLARE_double(min_segment_px);

@@ -98,26 +98,58 @@ EdgeDistance MeasureEdgeDistance(const Simulator& sim, const SimulatedFrame& f,
 }
 
 TEST(Simulator, LidarEdgesLieOnImageEdgesWithTruth) {
-  for (uint64_t seed : {3u, 11u}) {
-    const Simulator sim(SmallOptions(seed, 30));
-    for (int frame : {0, 25}) {
+  struct Case {
+    uint64_t seed;
+    SimCamera camera;
+    std::vector<int> frames;
+  };
+  for (const Case& c : {Case{3, SimCamera::kKitti, {0, 25}}, Case{11, SimCamera::kKitti, {0, 25}},
+                        Case{4, SimCamera::kKitti1003, {10}}, Case{4, SimCamera::kHd720, {10}}}) {
+    SimulatorOptions options = SmallOptions(c.seed, 30);
+    options.camera = c.camera;
+    const Simulator sim(options);
+    const std::string name =
+        "seed " + std::to_string(c.seed) + " camera " + SimCameraName(c.camera);
+    const CameraRig rig = MakeCameraRig(c.camera);
+    for (int frame : c.frames) {
       const SimulatedFrame f = sim.SimulateFrame(frame);
+      EXPECT_EQ(f.image_bgr.cols, rig.width) << name;
+      EXPECT_EQ(f.image_bgr.rows, rig.height) << name;
       const EdgeDistance truth = MeasureEdgeDistance(sim, f, sim.T_camera_lidar());
-      EXPECT_GT(truth.count, 200u) << "seed " << seed << " frame " << frame;
-      EXPECT_LE(truth.median_px, 1.5) << "seed " << seed << " frame " << frame;
+      EXPECT_GT(truth.count, 200u) << name << " frame " << frame;
+      EXPECT_LE(truth.median_px, 1.5) << name << " frame " << frame;
       // The same measure sees a 1° error: the check can fail.
       const Rigid3d wrong = PerturbTcameraLidar(sim.T_camera_lidar(), Eigen::Vector3d(0, 0.7, 0.7),
                                                 Eigen::Vector3d::Zero());
       const EdgeDistance off = MeasureEdgeDistance(sim, f, wrong);
-      EXPECT_LT(off.within_1_5px, truth.within_1_5px - 0.15)
-          << "seed " << seed << " frame " << frame;
+      EXPECT_LT(off.within_1_5px, truth.within_1_5px - 0.15) << name << " frame " << frame;
       std::printf(
-          "seed %llu frame %d: median %.2f px, %.0f%% within 1.5 px (truth); "
+          "%s frame %d: median %.2f px, %.0f%% within 1.5 px (truth); "
           "median %.2f px, %.0f%% (1 deg off)\n",
-          static_cast<unsigned long long>(seed), frame, truth.median_px, 100 * truth.within_1_5px,
-          off.median_px, 100 * off.within_1_5px);
+          name.c_str(), frame, truth.median_px, 100 * truth.within_1_5px, off.median_px,
+          100 * off.within_1_5px);
     }
   }
+}
+
+TEST(Simulator, CameraPresetsDifferAndParse) {
+  SimCamera camera;
+  for (SimCamera c : {SimCamera::kKitti, SimCamera::kKitti1003, SimCamera::kHd720}) {
+    ASSERT_TRUE(ParseSimCamera(SimCameraName(c), &camera));
+    EXPECT_EQ(camera, c);
+  }
+  EXPECT_FALSE(ParseSimCamera("fisheye", &camera));
+  // The hd720 mount looks 3° further down than the KITTI one of the same seed.
+  SimulatorOptions options = SmallOptions(2, 1);
+  const Simulator kitti(options);
+  options.camera = SimCamera::kHd720;
+  const Simulator hd(options);
+  const Eigen::Vector3d ahead_kitti = kitti.T_camera_lidar().linear() * Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d ahead_hd = hd.T_camera_lidar().linear() * Eigen::Vector3d::UnitX();
+  EXPECT_NEAR(std::atan2(ahead_kitti.y(), ahead_kitti.z()) - std::atan2(ahead_hd.y(), ahead_hd.z()),
+              3.0 * M_PI / 180.0, 1e-3);
+  EXPECT_EQ(MakeCameraRig(SimCamera::kKitti1003).width, 1241);
+  EXPECT_EQ(MakeCameraRig(SimCamera::kHd720).height, 720);
 }
 
 TEST(Simulator, OxtsIntegratesToTheTruePoses) {

@@ -97,6 +97,60 @@ std::string DataFormatText() {
 
 }  // namespace
 
+bool ParseSimCamera(const std::string& name, SimCamera* camera) {
+  if (name == "kitti")
+    *camera = SimCamera::kKitti;
+  else if (name == "kitti_1003")
+    *camera = SimCamera::kKitti1003;
+  else if (name == "hd720")
+    *camera = SimCamera::kHd720;
+  else
+    return false;
+  return true;
+}
+
+std::string SimCameraName(SimCamera camera) {
+  switch (camera) {
+    case SimCamera::kKitti:
+      return "kitti";
+    case SimCamera::kKitti1003:
+      return "kitti_1003";
+    case SimCamera::kHd720:
+      return "hd720";
+  }
+  return "?";
+}
+
+CameraRig MakeCameraRig(SimCamera camera) {
+  CameraRig rig;
+  switch (camera) {
+    case SimCamera::kKitti:
+      rig.R_rect_00 << 9.999239e-01, 9.837760e-03, -7.445048e-03, -9.869795e-03, 9.999421e-01,
+          -4.278459e-03, 7.402527e-03, 4.351614e-03, 9.999631e-01;
+      rig.P_rect_02 << 7.215377e+02, 0.0, 6.095593e+02, 4.485728e+01, 0.0, 7.215377e+02,
+          1.728540e+02, 2.163791e-01, 0.0, 0.0, 1.0, 2.745884e-03;
+      rig.width = 1242;
+      rig.height = 375;
+      break;
+    case SimCamera::kKitti1003:
+      rig.R_rect_00 << 9.999454e-01, 7.259129e-03, -7.519551e-03, -7.292213e-03, 9.999638e-01,
+          -4.381729e-03, 7.487471e-03, 4.436324e-03, 9.999621e-01;
+      rig.P_rect_02 << 7.188560e+02, 0.0, 6.071928e+02, 4.538225e+01, 0.0, 7.188560e+02,
+          1.852157e+02, -1.130887e-01, 0.0, 0.0, 1.0, 3.779761e-03;
+      rig.width = 1241;
+      rig.height = 376;
+      break;
+    case SimCamera::kHd720:
+      rig.R_rect_00.setIdentity();
+      rig.P_rect_02 << 800.0, 0.0, 652.0, 0.0, 0.0, 800.0, 349.0, 0.0, 0.0, 0.0, 1.0, 0.0;
+      rig.width = 1280;
+      rig.height = 720;
+      break;
+  }
+  rig.R_rect_00 = Eigen::Quaterniond(rig.R_rect_00).normalized().toRotationMatrix();
+  return rig;
+}
+
 Status SimulatorOptions::Validate() const {
   if (frames < 1 || frames > 100000) {
     return Status::Error("--frames must be between 1 and 100000, got " + std::to_string(frames));
@@ -138,16 +192,17 @@ Simulator::Simulator(const SimulatorOptions& options) : options_(options) {
   std::uniform_real_distribution<double> angle(-0.5, 0.5), offset(-0.02, 0.02);
   const Eigen::Vector3d rpy_deg(angle(calib_rng), angle(calib_rng), angle(calib_rng));
   T_camera_lidar_ = NominalTCameraLidar();
+  if (options.camera == SimCamera::kHd720) {
+    // Nose-down by 3°: a point straight ahead moves up the image (camera y is down).
+    T_camera_lidar_.linear() =
+        ExpSO3(Eigen::Vector3d(3.0 * M_PI / 180.0, 0, 0)) * T_camera_lidar_.linear();
+  }
   T_camera_lidar_.linear() = T_camera_lidar_.linear() * ExpSO3(rpy_deg * M_PI / 180.0);
   T_camera_lidar_.translation() +=
       Eigen::Vector3d(offset(calib_rng), offset(calib_rng), offset(calib_rng));
   T_lidar_imu_ = NominalTLidarImu();
 
-  rig_.R_rect_00 << 9.999239e-01, 9.837760e-03, -7.445048e-03, -9.869795e-03, 9.999421e-01,
-      -4.278459e-03, 7.402527e-03, 4.351614e-03, 9.999631e-01;
-  rig_.R_rect_00 = Eigen::Quaterniond(rig_.R_rect_00).normalized().toRotationMatrix();
-  rig_.P_rect_02 << 7.215377e+02, 0.0, 6.095593e+02, 4.485728e+01, 0.0, 7.215377e+02, 1.728540e+02,
-      2.163791e-01, 0.0, 0.0, 1.0, 2.745884e-03;
+  rig_ = MakeCameraRig(options.camera);
   rig_.T_imu_camera = T_lidar_imu_.inverse() * T_camera_lidar_.inverse();
   std::uniform_real_distribution<double> sun_azimuth(0, 2 * M_PI), sun_elevation(0.6, 1.1);
   const double az = sun_azimuth(calib_rng), el = sun_elevation(calib_rng);
@@ -313,6 +368,7 @@ Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& o
         {"generator", "stcalib simulate"},
         {"seed", options.seed},
         {"scene", SceneTypeName(options.scene)},
+        {"camera", SimCameraName(options.camera)},
         {"frames", options.frames},
         {"lidar_hz", options.lidar_hz},
         {"dynamic_objects", options.dynamic_objects},

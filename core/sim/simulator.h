@@ -17,6 +17,19 @@
 
 namespace stcalib::sim {
 
+// The camera of a simulated rig. Each has its own image size, intrinsics and rectification, so
+// that nothing downstream can assume one (the size is read from the image and the calib files).
+enum class SimCamera {
+  kKitti,      ///< KITTI 2011_09_26: 1242×375, f 721.5 px (default)
+  kKitti1003,  ///< KITTI 2011_10_03 geometry: 1241×376, f 718.9 px, its own rectification
+  kHd720,  ///< 1280×720, f 800 px (77°×48°), principal point off centre, mounted 3° nose-down;
+           ///< the image reaches far above the LiDAR's +2° top beam
+};
+bool ParseSimCamera(const std::string& name, SimCamera* camera);
+std::string SimCameraName(SimCamera camera);
+// Intrinsics, rectification and size of `camera` (pose, sun and noise keep their defaults).
+CameraRig MakeCameraRig(SimCamera camera);
+
 struct SimulatorOptions {
   int frames = 40;             ///< frames to simulate (camera, LiDAR and oxts each)
   uint64_t seed = 1;           ///< everything random derives from it
@@ -25,6 +38,7 @@ struct SimulatorOptions {
   SceneType scene = SceneType::kUrban;
   double lidar_hz = 10.0;          ///< spin rate = frame rate of every sensor [Hz]
   double camera_delay_s = 0.0105;  ///< camera exposure after the LiDAR faces forward [s]
+  SimCamera camera = SimCamera::kKitti;
 
   Status Validate() const;
 };
