@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/sim/enum_names.h"
+
 namespace stcalib::sim {
 namespace {
 
@@ -134,29 +136,16 @@ Eigen::Vector3d RandomColour(std::mt19937_64* rng, double lo, double hi) {
 
 }  // namespace
 
+namespace {
+constexpr EnumNames<SceneType, 3> kSceneNames = {
+    {{SceneType::kUrban, "urban"}, {SceneType::kPoles, "poles"}, {SceneType::kOpen, "open"}}};
+}  // namespace
+
 bool ParseSceneType(const std::string& name, SceneType* type) {
-  if (name == "urban")
-    *type = SceneType::kUrban;
-  else if (name == "poles")
-    *type = SceneType::kPoles;
-  else if (name == "open")
-    *type = SceneType::kOpen;
-  else
-    return false;
-  return true;
+  return ParseEnumName(kSceneNames, name, type);
 }
 
-std::string SceneTypeName(SceneType type) {
-  switch (type) {
-    case SceneType::kUrban:
-      return "urban";
-    case SceneType::kPoles:
-      return "poles";
-    case SceneType::kOpen:
-      return "open";
-  }
-  return "?";
-}
+std::string SceneTypeName(SceneType type) { return EnumName(kSceneNames, type); }
 
 double CellNoise(const Eigen::Vector3d& p, double cell_m) {
   uint64_t h = 0x9E3779B97F4A7C15ULL;

@@ -10,6 +10,7 @@
 #include "core/io/image.h"
 #include "core/io/text.h"
 #include "core/io/velodyne.h"
+#include "core/sim/enum_names.h"
 
 namespace stcalib::sim {
 namespace {
@@ -97,29 +98,17 @@ std::string DataFormatText() {
 
 }  // namespace
 
+namespace {
+constexpr EnumNames<SimCamera, 3> kCameraNames = {{{SimCamera::kKitti, "kitti"},
+                                                   {SimCamera::kKitti1003, "kitti_1003"},
+                                                   {SimCamera::kHd720, "hd720"}}};
+}  // namespace
+
 bool ParseSimCamera(const std::string& name, SimCamera* camera) {
-  if (name == "kitti")
-    *camera = SimCamera::kKitti;
-  else if (name == "kitti_1003")
-    *camera = SimCamera::kKitti1003;
-  else if (name == "hd720")
-    *camera = SimCamera::kHd720;
-  else
-    return false;
-  return true;
+  return ParseEnumName(kCameraNames, name, camera);
 }
 
-std::string SimCameraName(SimCamera camera) {
-  switch (camera) {
-    case SimCamera::kKitti:
-      return "kitti";
-    case SimCamera::kKitti1003:
-      return "kitti_1003";
-    case SimCamera::kHd720:
-      return "hd720";
-  }
-  return "?";
-}
+std::string SimCameraName(SimCamera camera) { return EnumName(kCameraNames, camera); }
 
 CameraRig MakeCameraRig(SimCamera camera) {
   CameraRig rig;

@@ -1,0 +1,34 @@
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <utility>
+
+namespace stcalib::sim {
+
+// A table of an enum's values and their flag names (`--scene=urban`, `--camera=hd720`).
+template <typename Enum, size_t N>
+using EnumNames = std::array<std::pair<Enum, const char*>, N>;
+
+// The value named `name`; false (and `value` untouched) for an unknown name.
+template <typename Enum, size_t N>
+bool ParseEnumName(const EnumNames<Enum, N>& names, const std::string& name, Enum* value) {
+  for (const auto& [v, n] : names) {
+    if (name == n) {
+      *value = v;
+      return true;
+    }
+  }
+  return false;
+}
+
+template <typename Enum, size_t N>
+std::string EnumName(const EnumNames<Enum, N>& names, Enum value) {
+  for (const auto& [v, n] : names) {
+    if (v == value) return n;
+  }
+  return "?";
+}
+
+}  // namespace stcalib::sim
