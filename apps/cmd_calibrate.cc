@@ -330,12 +330,18 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     observable_json[kAxisNames[k]] = refine.observable[k];
   }
   const Eigen::Vector3d rpy_deg = EulerRpyDeg(outcome->estimate.T_camera_lidar.linear());
-  // Per frame, over all frames (those without an update count as 0 ms).
-  double search_ms = 0, refine_ms = 0;
+  // Per frame, over all frames (those without an update count as 0 ms), and per update.
+  double search_ms = 0, refine_ms = 0, update_ms = 0;
+  int updates = 0;
   for (const FrameReport& r : outcome->reports) {
     search_ms += r.search_ms / outcome->reports.size();
     refine_ms += r.refine_ms / outcome->reports.size();
+    if (r.ran_update()) {
+      update_ms += r.search_ms + r.refine_ms;
+      ++updates;
+    }
   }
+  if (updates > 0) update_ms /= updates;
   nlohmann::json result = {
       {"T_camera_lidar", MatrixJson(outcome->estimate.T_camera_lidar)},
       {"time_offset_s", outcome->estimate.time_offset_s},
@@ -360,6 +366,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
        {{"per_frame_mean", outcome->mean_frame_ms},
         {"search_mean", search_ms},
         {"refine_mean", refine_ms},
+        {"updates", updates},
+        {"update_mean", update_ms},
         {"total",
          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run_start)
              .count()}}},

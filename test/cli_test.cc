@@ -524,8 +524,22 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
   EXPECT_TRUE(result["polish"]["applied"].get<bool>()) << result["polish"]["reason"];
   // The first frames find the calibration's peak, not a side peak 4-6° off (measured 0.71° at
   // the fifth frame from a 3.46° start).
-  EXPECT_LT(PerFrameNumber(testing::ReadFile(out + "/per_frame.csv"), 4, "rotation_error_deg"),
-            1.0);
+  const std::string csv = testing::ReadFile(out + "/per_frame.csv");
+  EXPECT_LT(PerFrameNumber(csv, 4, "rotation_error_deg"), 1.0);
+  // timing_ms per update: the frames that searched (and refined), by per_frame.csv. While
+  // tracking, the frames between updates do neither.
+  int updates = 0;
+  double update_ms = 0;
+  for (size_t row = 0; row < 30; ++row) {
+    if (PerFrameNumber(csv, row, "search_ms") > 0) {
+      ++updates;
+      update_ms += PerFrameNumber(csv, row, "search_ms") + PerFrameNumber(csv, row, "refine_ms");
+    }
+  }
+  EXPECT_EQ(result["timing_ms"]["updates"].get<int>(), updates);
+  EXPECT_LT(updates, 30);
+  EXPECT_GT(updates, 10);
+  EXPECT_NEAR(result["timing_ms"]["update_mean"].get<double>(), update_ms / updates, 0.01);
 }
 
 // δ started 50 ms off and the δ scan switched off: the estimate ends on a side peak about 4°
