@@ -31,6 +31,7 @@ struct CalibrateOutcome {
   std::string reason;
   bool has_truth = false;
   std::string reference;  ///< "ground truth (simulated)" or "drive calibration"
+  std::string motion;     ///< where Tv comes from: "oxts" or "scan_registration"
   CalibrationState reference_state, initial, estimate;
   CalibrationError error, initial_error;
   std::vector<FrameReport> reports;

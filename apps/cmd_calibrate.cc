@@ -201,6 +201,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   std::unique_ptr<DriveFrameSource> source;
   status = DriveFrameSource::Create(&drive, source_options, &source);
   if (!status.ok()) return ReportError(kCommand, status);
+  outcome->motion =
+      source->motion().source() == DriveMotion::Source::kOxts ? "oxts" : "scan_registration";
 
   std::error_code ec;
   fs::create_directories(job.out_dir, ec);
@@ -373,6 +375,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
              .count()}}},
       {"polish", PolishJson(outcome->polish)},
       {"reference", outcome->reference},
+      {"motion", outcome->motion},
       {"initial_error", ErrorJson(outcome->initial_error)},
   };
   if (outcome->has_truth) {

@@ -309,20 +309,41 @@ TEST(Cli, CalibrateSkipsFaultyFramesKeepsTheEstimateAndRecovers) {
   EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.015);
 }
 
-// A drive without oxts/: the motion model comes from registering consecutive sweeps with a
-// constant velocity between them (method.md §3's fallback), and the calibration still works.
+// A drive without oxts/, or whose oxts cannot be used (no calib_imu_to_velo.txt): the motion
+// model comes from registering consecutive sweeps with a constant velocity between them
+// (method.md §3's fallback), result.json says so, and the calibration still works.
 TEST(Cli, CalibratesADriveWithoutOxtsFromScanRegistration) {
   testing::ScopedTempDir tmp;
   const std::string drive = SimulateDrive(tmp.path(), "--frames=12 --seed=3 --time_offset_s=0.03");
   ASSERT_FALSE(drive.empty());
+  // oxts/ without calib_imu_to_velo.txt: the packets cannot be carried to the LiDAR.
+  const std::string imu_calib =
+      std::filesystem::path(drive).parent_path().string() + "/calib_imu_to_velo.txt";
+  const std::string no_imu_calib = tmp.path() + "/no_imu_calib";
+  std::filesystem::rename(imu_calib, tmp.path() + "/calib_imu_to_velo.txt");
+  const RunResult without_calib = CalibrateFromTwoDegrees(drive, no_imu_calib, 3, kShortDrive);
+  EXPECT_EQ(without_calib.exit_code, 0) << without_calib.output;
+  EXPECT_THAT(without_calib.output,
+              HasSubstr("calib_imu_to_velo.txt: missing, so the oxts motion cannot be used; the "
+                        "motion comes from registering consecutive sweeps"));
+  const nlohmann::json result_without_calib =
+      nlohmann::json::parse(testing::ReadFile(no_imu_calib + "/result.json"));
+  EXPECT_EQ(result_without_calib["motion"], "scan_registration");
+  EXPECT_LT(result_without_calib["error"]["rotation_deg"].get<double>(), 0.5);
+
+  std::filesystem::rename(tmp.path() + "/calib_imu_to_velo.txt", imu_calib);
   std::filesystem::remove_all(drive + "/oxts");
   const std::string out = tmp.path() + "/out";
   const RunResult r = CalibrateFromTwoDegrees(drive, out, 3, kShortDrive);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("no oxts; the motion comes from registering consecutive sweeps"));
   const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
+  EXPECT_EQ(result["motion"], "scan_registration");
   EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.5) << r.output;
   EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.01) << r.output;
+  // The same drive and calibration give the same estimate either way.
+  EXPECT_NEAR(result["error"]["rotation_deg"].get<double>(),
+              result_without_calib["error"]["rotation_deg"].get<double>(), 1e-9);
 }
 
 // The paper's disturbance protocol at the very end of a drive: the 3.5° disturbance two frames
@@ -515,6 +536,7 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
   const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
   const auto& agreement = result["agreement_with_drive_calibration"];
   EXPECT_TRUE(result["converged"].get<bool>()) << result["reason"];
+  EXPECT_EQ(result["motion"], "oxts");
   // Measured 0.28° (the online estimate was 0.20° off; the polish moved it 0.11° to the
   // refinement's optimum, which over these frames lies 0.25-0.32° from KITTI's on roll).
   EXPECT_LT(agreement["rotation_deg"].get<double>(), 0.35) << r.output;

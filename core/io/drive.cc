@@ -144,7 +144,8 @@ Status OpenDrive(const std::string& drive_dir_in, const std::string& calib_dir_i
     STCALIB_RETURN_IF_ERROR(ReadImuToVelo(imu_path, &drive->T_lidar_imu));
     drive->has_imu_calibration = true;
   } else if (drive->has_oxts) {
-    return Status::Error(imu_path + ": file not found (needed with oxts/ to use the IMU motion)");
+    // The oxts motion cannot be carried to the LiDAR; the frame source registers sweeps instead.
+    LOG(WARNING) << imu_path << ": not found, so the oxts/ packets cannot be used";
   }
   return Status::Ok();
 }

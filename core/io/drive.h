@@ -24,8 +24,8 @@ struct Drive {
 
   CameraCalibration camera;
   Rigid3d T_camera_lidar = Rigid3d::Identity();  ///< from calib_velo_to_cam.txt
-  bool has_imu_calibration = false;
-  Rigid3d T_lidar_imu = Rigid3d::Identity();  ///< from calib_imu_to_velo.txt
+  bool has_imu_calibration = false;              ///< calib_imu_to_velo.txt read (oxts need it)
+  Rigid3d T_lidar_imu = Rigid3d::Identity();     ///< from calib_imu_to_velo.txt
 
   std::vector<StampNs> camera_stamps_ns;       ///< image_02/timestamps.txt
   std::vector<StampNs> lidar_stamps_ns;        ///< velodyne_points/timestamps.txt

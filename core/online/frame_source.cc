@@ -60,12 +60,15 @@ Status DriveFrameSource::Create(const Drive* drive, const FrameSourceOptions& op
     s->options_.lidar.dynamic.roi_center_azimuth_deg = window.x();
     s->options_.lidar.dynamic.roi_half_angle_deg = window.y();
   }
-  if (drive->has_oxts) {
+  if (drive->has_oxts && drive->has_imu_calibration) {
     STCALIB_RETURN_IF_ERROR(DriveMotion::Create(*drive, &s->motion_));
   } else {
-    LOG(WARNING) << drive->drive_dir
-                 << ": no oxts; the motion comes from registering consecutive sweeps (NDT) "
-                    "with a constant velocity between them";
+    LOG(WARNING) << (drive->has_oxts ? drive->calib_dir +
+                                           "/calib_imu_to_velo.txt: missing, so "
+                                           "the oxts motion cannot be used"
+                                     : drive->drive_dir + ": no oxts")
+                 << "; the motion comes from registering consecutive sweeps (NDT) with a "
+                    "constant velocity between them";
     STCALIB_RETURN_IF_ERROR(DriveMotion::CreateFromScans(*drive, &s->motion_));
   }
   s->cache_ = std::make_unique<SweepCache>(*drive, s->motion_, s->options_.lidar);
@@ -79,8 +82,9 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   const double camera_s = motion_.Seconds(drive_->camera_stamps_ns[frame]);
   const double oxts_gap_s = motion_.GapAround(camera_s);
   if (oxts_gap_s > options_.max_oxts_gap_s) {
-    return Status::Error(drive_->drive_dir + (drive_->has_oxts ? "/oxts" : "/velodyne_points") +
-                         ": frame " + std::to_string(frame) + " falls in a gap of " +
+    const bool oxts = motion_.source() == DriveMotion::Source::kOxts;
+    return Status::Error(drive_->drive_dir + (oxts ? "/oxts" : "/velodyne_points") + ": frame " +
+                         std::to_string(frame) + " falls in a gap of " +
                          std::to_string(oxts_gap_s) + " s between motion measurements (more than " +
                          std::to_string(options_.max_oxts_gap_s) + " s): no motion model");
   }

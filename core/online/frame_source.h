@@ -60,8 +60,9 @@ Eigen::Vector2d CameraAzimuthWindowDeg(const CameraCalibration& camera, int imag
 
 class DriveFrameSource {
  public:
-  // The motion model comes from the drive's oxts, or, without oxts/, from registering
-  // consecutive sweeps (constant velocity); errors say why neither works.
+  // The motion model comes from the drive's oxts, or, without oxts/ or without
+  // calib_imu_to_velo.txt, from registering consecutive sweeps (constant velocity); errors say
+  // why neither works.
   static Status Create(const Drive* drive, const FrameSourceOptions& options,
                        std::unique_ptr<DriveFrameSource>* source);
   Status Load(size_t frame, CalibrationFrame* out);
