@@ -41,7 +41,7 @@ int RunFeatures() {
   if (status.ok()) status = drive.CheckFrame(FLAGS_frame);
   if (!status.ok()) return ReportError("features", status);
   DriveMotion motion;
-  status = DriveMotion::Create(drive, &motion);
+  status = DriveMotion::CreateForDrive(drive, &motion);
   if (!status.ok()) return ReportError("features", status);
   std::error_code ec;
   std::filesystem::create_directories(FLAGS_out, ec);

@@ -341,9 +341,9 @@ TEST(Cli, CalibratesADriveWithoutOxtsFromScanRegistration) {
   EXPECT_EQ(result["motion"], "scan_registration");
   EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.5) << r.output;
   EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.01) << r.output;
-  // The same drive and calibration give the same estimate either way.
-  EXPECT_NEAR(result["error"]["rotation_deg"].get<double>(),
-              result_without_calib["error"]["rotation_deg"].get<double>(), 1e-9);
+  // The same drive gives the same estimate either way.
+  EXPECT_EQ(result["T_camera_lidar"], result_without_calib["T_camera_lidar"]);
+  EXPECT_EQ(result["time_offset_s"], result_without_calib["time_offset_s"]);
 }
 
 // The paper's disturbance protocol at the very end of a drive: the 3.5° disturbance two frames
@@ -387,31 +387,6 @@ TEST(Cli, CalibratesALargeTimeOffsetAndNeverClaimsAWrongOne) {
   EXPECT_EQ(local.exit_code, 1) << local.output;
   EXPECT_THAT(local.output, HasSubstr("score over δ peaks"));
   EXPECT_FALSE(std::filesystem::exists(out + "/time_offset.txt"));
-}
-
-// Another rig than KITTI's: a 1280×720 camera, f 800 px, principal point off centre, mounted 3°
-// nose-down, whose upper 40 % no LiDAR beam reaches. Everything image-sized is read from the
-// image and the calib files. Measured: 0.18° (seeds 5 and 6 of this drive), δ error +3.1 ms;
-// the 20-frame drives of seeds 1-4 end 0.067-0.078° off.
-TEST(Cli, CalibratesAnotherCameraAndImageSize) {
-  testing::ScopedTempDir tmp;
-  const std::string drive =
-      SimulateDrive(tmp.path(), "--frames=14 --seed=5 --time_offset_s=0.03 --camera=hd720");
-  ASSERT_FALSE(drive.empty());
-  EXPECT_THAT(testing::ReadFile(std::filesystem::path(drive).parent_path().string() +
-                                "/calib_cam_to_cam.txt"),
-              HasSubstr("S_rect_02: 1.280000000000e+03 7.200000000000e+02"));
-  const std::string out = tmp.path() + "/out";
-  const RunResult r = CalibrateFromTwoDegrees(drive, out, 5, kShortDrive);
-  EXPECT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
-  EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.3) << r.output;
-  EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.006) << r.output;
-  EXPECT_LT(result["error"]["translation_m"].get<double>(), 0.08) << r.output;
-  cv::Mat overlay;
-  ASSERT_TRUE(ReadImage(out + "/overlay_after.png", &overlay).ok());
-  EXPECT_EQ(overlay.cols, 1280);
-  EXPECT_EQ(overlay.rows, 720);
 }
 
 // Degenerate scenes (method.md §7): an open road (lane markings and kerbs only) leaves rotation
@@ -518,6 +493,25 @@ double PerFrameNumber(const std::string& csv, size_t row, const std::string& col
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+// result.json's timing_ms per update against per_frame.csv (`rows` data rows): the frames that
+// searched (and refined) are the updates. Returns how many there were.
+int ExpectUpdateTimingMatches(const nlohmann::json& result, const std::string& csv, size_t rows) {
+  int updates = 0;
+  double update_ms = 0;
+  for (size_t row = 0; row < rows; ++row) {
+    if (PerFrameNumber(csv, row, "search_ms") > 0) {
+      ++updates;
+      update_ms += PerFrameNumber(csv, row, "search_ms") + PerFrameNumber(csv, row, "refine_ms");
+    }
+  }
+  EXPECT_EQ(result["timing_ms"]["updates"].get<int>(), updates);
+  EXPECT_GT(updates, 0);
+  // Each CSV value is rounded to 0.005 ms.
+  EXPECT_NEAR(result["timing_ms"]["update_mean"].get<double>(), update_ms / std::max(updates, 1),
+              0.011);
+  return updates;
+}
+
 // `calibrate --flagfile=configs/kitti.flags` from ±2° on roll, pitch and yaw (issue 5's KITTI
 // protocol) on the shared frames.
 RunResult CalibrateKitti(const std::string& out, const std::string& args) {
@@ -548,20 +542,10 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
   // the fifth frame from a 3.46° start).
   const std::string csv = testing::ReadFile(out + "/per_frame.csv");
   EXPECT_LT(PerFrameNumber(csv, 4, "rotation_error_deg"), 1.0);
-  // timing_ms per update: the frames that searched (and refined), by per_frame.csv. While
-  // tracking, the frames between updates do neither.
-  int updates = 0;
-  double update_ms = 0;
-  for (size_t row = 0; row < 30; ++row) {
-    if (PerFrameNumber(csv, row, "search_ms") > 0) {
-      ++updates;
-      update_ms += PerFrameNumber(csv, row, "search_ms") + PerFrameNumber(csv, row, "refine_ms");
-    }
-  }
-  EXPECT_EQ(result["timing_ms"]["updates"].get<int>(), updates);
+  // While tracking, the frames between updates neither search nor refine.
+  const int updates = ExpectUpdateTimingMatches(result, csv, 30);
   EXPECT_LT(updates, 30);
   EXPECT_GT(updates, 10);
-  EXPECT_NEAR(result["timing_ms"]["update_mean"].get<double>(), update_ms / updates, 0.01);
 }
 
 // δ started 50 ms off and the δ scan switched off: the estimate ends on a side peak about 4°
@@ -632,6 +616,35 @@ TEST(Cli, KittiSingleFrameEstimatesOnlyWithASingleFrameWindow) {
   EXPECT_LT(result["agreement_with_drive_calibration"]["rotation_deg"].get<double>(),
             0.5 * result["initial_error"]["rotation_deg"].get<double>())
       << one.output;
+}
+
+// Another rig than KITTI's: a 1280×720 camera, f 800 px, principal point off centre, mounted 3°
+// nose-down, whose upper 40 % no LiDAR beam reaches. Everything image-sized is read from the
+// image and the calib files. Measured: 0.177° and 0.179° (seeds 5 and 6 on this drive), δ error
+// +3.1 ms, translation 7.2 cm from 8.7 (forward is held by the prior); 20-frame drives of seeds
+// 1-8 end 0.071-0.133° off.
+TEST(Cli, CalibratesAnotherCameraAndImageSize) {
+  testing::ScopedTempDir tmp;
+  const std::string drive =
+      SimulateDrive(tmp.path(), "--frames=14 --seed=5 --time_offset_s=0.03 --camera=hd720");
+  ASSERT_FALSE(drive.empty());
+  EXPECT_THAT(testing::ReadFile(std::filesystem::path(drive).parent_path().string() +
+                                "/calib_cam_to_cam.txt"),
+              HasSubstr("S_rect_02: 1.280000000000e+03 7.200000000000e+02"));
+  const std::string out = tmp.path() + "/out";
+  const RunResult r = CalibrateFromTwoDegrees(drive, out, 5, kShortDrive);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
+  EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.3) << r.output;
+  EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.006) << r.output;
+  EXPECT_LT(result["error"]["translation_m"].get<double>(), 0.08) << r.output;
+  EXPECT_EQ(result["motion"], "oxts");
+  // The first two frames fill the search window without an update.
+  EXPECT_LE(ExpectUpdateTimingMatches(result, testing::ReadFile(out + "/per_frame.csv"), 14), 12);
+  cv::Mat overlay;
+  ASSERT_TRUE(ReadImage(out + "/overlay_after.png", &overlay).ok());
+  EXPECT_EQ(overlay.cols, 1280);
+  EXPECT_EQ(overlay.rows, 720);
 }
 
 }  // namespace

@@ -133,7 +133,7 @@ Status OpenDrive(const std::string& drive_dir_in, const std::string& calib_dir_i
     }
     drive->has_oxts = true;
   } else {
-    LOG(WARNING) << oxts_dir << ": no oxts folder; motion comes from the constant-velocity model";
+    VLOG(1) << oxts_dir << ": no oxts folder";
   }
 
   STCALIB_RETURN_IF_ERROR(ReadCamToCam(drive->calib_dir + "/calib_cam_to_cam.txt", &drive->camera));
@@ -143,10 +143,9 @@ Status OpenDrive(const std::string& drive_dir_in, const std::string& calib_dir_i
   if (fs::exists(imu_path, ec)) {
     STCALIB_RETURN_IF_ERROR(ReadImuToVelo(imu_path, &drive->T_lidar_imu));
     drive->has_imu_calibration = true;
-  } else if (drive->has_oxts) {
-    // The oxts motion cannot be carried to the LiDAR; the frame source registers sweeps instead.
-    LOG(WARNING) << imu_path << ": not found, so the oxts/ packets cannot be used";
   }
+  // Without it the oxts motion cannot be carried to the LiDAR (DriveMotion::CreateForDrive
+  // registers the sweeps instead, and says so).
   return Status::Ok();
 }
 

@@ -26,6 +26,17 @@ Status DriveMotion::Create(const Drive& drive, DriveMotion* motion) {
   return Status::Ok();
 }
 
+Status DriveMotion::CreateForDrive(const Drive& drive, DriveMotion* motion) {
+  if (drive.has_oxts && drive.has_imu_calibration) return Create(drive, motion);
+  LOG(WARNING) << (drive.has_oxts ? drive.calib_dir +
+                                        "/calib_imu_to_velo.txt: missing, so the "
+                                        "oxts motion cannot be used"
+                                  : drive.drive_dir + ": no oxts")
+               << "; the motion comes from registering consecutive sweeps (NDT) with a constant "
+                  "velocity between them";
+  return CreateFromScans(drive, motion);
+}
+
 Status DriveMotion::CreateFromScans(const Drive& drive, DriveMotion* motion) {
   const size_t n = drive.NumFrames();
   if (n < 2) return Status::Error(drive.drive_dir + ": scan registration needs two sweeps or more");

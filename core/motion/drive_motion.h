@@ -23,6 +23,9 @@ class DriveMotion {
   static Status Create(const Drive& drive, DriveMotion* motion);
   // Fails when fewer than two sweeps can be read and registered.
   static Status CreateFromScans(const Drive& drive, DriveMotion* motion);
+  // Create when the drive has oxts and calib_imu_to_velo.txt, else CreateFromScans with a
+  // warning that says why.
+  static Status CreateForDrive(const Drive& drive, DriveMotion* motion);
 
   Source source() const { return source_; }
   Rigid3d T_world_lidar(double t_s) const;

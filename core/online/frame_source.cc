@@ -60,17 +60,7 @@ Status DriveFrameSource::Create(const Drive* drive, const FrameSourceOptions& op
     s->options_.lidar.dynamic.roi_center_azimuth_deg = window.x();
     s->options_.lidar.dynamic.roi_half_angle_deg = window.y();
   }
-  if (drive->has_oxts && drive->has_imu_calibration) {
-    STCALIB_RETURN_IF_ERROR(DriveMotion::Create(*drive, &s->motion_));
-  } else {
-    LOG(WARNING) << (drive->has_oxts ? drive->calib_dir +
-                                           "/calib_imu_to_velo.txt: missing, so "
-                                           "the oxts motion cannot be used"
-                                     : drive->drive_dir + ": no oxts")
-                 << "; the motion comes from registering consecutive sweeps (NDT) with a "
-                    "constant velocity between them";
-    STCALIB_RETURN_IF_ERROR(DriveMotion::CreateFromScans(*drive, &s->motion_));
-  }
+  STCALIB_RETURN_IF_ERROR(DriveMotion::CreateForDrive(*drive, &s->motion_));
   s->cache_ = std::make_unique<SweepCache>(*drive, s->motion_, s->options_.lidar);
   *source = std::move(s);
   return Status::Ok();

@@ -134,11 +134,9 @@ Eigen::Vector3d RandomColour(std::mt19937_64* rng, double lo, double hi) {
   return Eigen::Vector3d(u(*rng), u(*rng), u(*rng));
 }
 
-}  // namespace
-
-namespace {
 constexpr EnumNames<SceneType, 3> kSceneNames = {
     {{SceneType::kUrban, "urban"}, {SceneType::kPoles, "poles"}, {SceneType::kOpen, "open"}}};
+
 }  // namespace
 
 bool ParseSceneType(const std::string& name, SceneType* type) {

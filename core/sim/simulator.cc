@@ -96,12 +96,10 @@ std::string DataFormatText() {
          "orimode:       orientation mode of primary GPS receiver\n";
 }
 
-}  // namespace
-
-namespace {
 constexpr EnumNames<SimCamera, 3> kCameraNames = {{{SimCamera::kKitti, "kitti"},
                                                    {SimCamera::kKitti1003, "kitti_1003"},
                                                    {SimCamera::kHd720, "hd720"}}};
+
 }  // namespace
 
 bool ParseSimCamera(const std::string& name, SimCamera* camera) {
@@ -182,9 +180,11 @@ Simulator::Simulator(const SimulatorOptions& options) : options_(options) {
   const Eigen::Vector3d rpy_deg(angle(calib_rng), angle(calib_rng), angle(calib_rng));
   T_camera_lidar_ = NominalTCameraLidar();
   if (options.camera == SimCamera::kHd720) {
-    // Nose-down by 3°: a point straight ahead moves up the image (camera y is down).
-    T_camera_lidar_.linear() =
-        ExpSO3(Eigen::Vector3d(3.0 * M_PI / 180.0, 0, 0)) * T_camera_lidar_.linear();
+    // Nose-down by 3° about the camera centre (which stays at KITTI's mount): a point straight
+    // ahead moves up the image (camera y is down).
+    T_camera_lidar_ =
+        MakeRigid(ExpSO3(Eigen::Vector3d(3.0 * M_PI / 180.0, 0, 0)), Eigen::Vector3d::Zero()) *
+        T_camera_lidar_;
   }
   T_camera_lidar_.linear() = T_camera_lidar_.linear() * ExpSO3(rpy_deg * M_PI / 180.0);
   T_camera_lidar_.translation() +=
