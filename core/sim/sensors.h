@@ -47,6 +47,8 @@ struct CameraRig {
   Eigen::Matrix3d R_rect_00 = Eigen::Matrix3d::Identity();
   Eigen::Matrix<double, 3, 4> P_rect_02 = Eigen::Matrix<double, 3, 4>::Zero();
   int width = 1242, height = 375;
+  // The camera's mount tilted nose-down about its own centre, relative to KITTI's [deg].
+  double nose_down_deg = 0.0;
   Rigid3d T_imu_camera = Rigid3d::Identity();  ///< unrectified camera 0 in the IMU frame
   Eigen::Vector3d sun_world = Eigen::Vector3d(0.3, 0.4, 0.87).normalized();
   double noise_sigma = 2.0;  ///< image noise σ [grey levels]

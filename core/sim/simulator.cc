@@ -132,6 +132,7 @@ CameraRig MakeCameraRig(SimCamera camera) {
       rig.P_rect_02 << 800.0, 0.0, 652.0, 0.0, 0.0, 800.0, 349.0, 0.0, 0.0, 0.0, 1.0, 0.0;
       rig.width = 1280;
       rig.height = 720;
+      rig.nose_down_deg = 3.0;
       break;
   }
   rig.R_rect_00 = Eigen::Quaterniond(rig.R_rect_00).normalized().toRotationMatrix();
@@ -178,20 +179,17 @@ Simulator::Simulator(const SimulatorOptions& options) : options_(options) {
   std::mt19937_64 calib_rng = MakeRng(seed, kCalibration);
   std::uniform_real_distribution<double> angle(-0.5, 0.5), offset(-0.02, 0.02);
   const Eigen::Vector3d rpy_deg(angle(calib_rng), angle(calib_rng), angle(calib_rng));
-  T_camera_lidar_ = NominalTCameraLidar();
-  if (options.camera == SimCamera::kHd720) {
-    // Nose-down by 3° about the camera centre (which stays at KITTI's mount): a point straight
-    // ahead moves up the image (camera y is down).
-    T_camera_lidar_ =
-        MakeRigid(ExpSO3(Eigen::Vector3d(3.0 * M_PI / 180.0, 0, 0)), Eigen::Vector3d::Zero()) *
-        T_camera_lidar_;
-  }
+  rig_ = MakeCameraRig(options.camera);
+  // The rig's nose-down tilt about the camera centre (which stays at KITTI's mount): a point
+  // straight ahead moves up the image (camera y is down).
+  T_camera_lidar_ = MakeRigid(ExpSO3(Eigen::Vector3d(rig_.nose_down_deg * M_PI / 180.0, 0, 0)),
+                              Eigen::Vector3d::Zero()) *
+                    NominalTCameraLidar();
   T_camera_lidar_.linear() = T_camera_lidar_.linear() * ExpSO3(rpy_deg * M_PI / 180.0);
   T_camera_lidar_.translation() +=
       Eigen::Vector3d(offset(calib_rng), offset(calib_rng), offset(calib_rng));
   T_lidar_imu_ = NominalTLidarImu();
 
-  rig_ = MakeCameraRig(options.camera);
   rig_.T_imu_camera = T_lidar_imu_.inverse() * T_camera_lidar_.inverse();
   std::uniform_real_distribution<double> sun_azimuth(0, 2 * M_PI), sun_elevation(0.6, 1.1);
   const double az = sun_azimuth(calib_rng), el = sun_elevation(calib_rng);
