@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -133,6 +134,14 @@ CameraModel TestCamera() {
   return camera;
 }
 
+// EdgeAlignmentCost of one frame's points, with the same map for both edge kinds.
+EdgeAlignmentCost FrameCost(std::vector<EdgeAlignmentCost::Point> points, const LidarTwist& twist,
+                            double e0_s, const CameraModel* camera, const SyntheticMap& map,
+                            const ceres::LossFunction* loss = nullptr) {
+  return EdgeAlignmentCost(std::move(points), twist, e0_s, camera,
+                           {map.interpolator.get(), map.interpolator.get()}, 20.0, loss);
+}
+
 TEST(EdgeAlignmentCost, NominalValueByHand) {
   // A linear map D = 0.01·u + 0.02·v + 1 (bicubic interpolation reproduces it exactly).
   const SyntheticMap map(1200, 360, [](double u, double v) { return 0.01 * u + 0.02 * v + 1; });
@@ -144,43 +153,88 @@ TEST(EdgeAlignmentCost, NominalValueByHand) {
   twist.linear_m_s = Eigen::Vector3d(0, 0, 10);  // along the camera axis below (identity pose)
   // Identity extrinsic, p = (1, 0.5, 20), e = e0 + δ = −0.01 + 0.03 = 0.02 s → p' = (1, 0.5, 20.2)
   // u = 600 + 700·1/20.2, v = 180 + 700·0.5/20.2, r = √4 · D(u, v).
-  const EdgeAlignmentCost cost(Eigen::Vector3d(1, 0.5, 20), 4.0, twist, -0.01, &camera,
-                               map.interpolator.get(), 20.0);
+  // The second point is behind the camera: the constant cap, weighted (√9 · 20).
+  const EdgeAlignmentCost cost =
+      FrameCost({{Eigen::Vector3d(1, 0.5, 20), 4.0, 0}, {Eigen::Vector3d(1, 0.5, -20), 9.0, 1}},
+                twist, -0.01, &camera, map);
+  ASSERT_EQ(cost.num_residuals(), 2);
   const double pose[7] = {0, 0, 0, 1, 0, 0, 0};
   const double delta = 0.03;
-  double residual = 0;
+  double residuals[2];
   const double* params[2] = {pose, &delta};
-  ASSERT_TRUE(cost.Evaluate(params, &residual, nullptr));
+  ASSERT_TRUE(cost.Evaluate(params, residuals, nullptr));
   const double u = 600 + 700.0 / 20.2, v = 180 + 350.0 / 20.2;
-  EXPECT_NEAR(residual, 2.0 * (0.01 * u + 0.02 * v + 1), 1e-5);
-  // Behind the camera: the constant cap, weighted.
-  const EdgeAlignmentCost behind(Eigen::Vector3d(1, 0.5, -20), 4.0, twist, -0.01, &camera,
-                                 map.interpolator.get(), 20.0);
-  ASSERT_TRUE(behind.Evaluate(params, &residual, nullptr));
-  EXPECT_DOUBLE_EQ(residual, 40.0);
-  // ... with zero derivatives, whichever blocks are asked for.
-  double j_pose[7], j_delta = 1.0;
-  std::fill(j_pose, j_pose + 7, 1.0);
-  double* both[2] = {j_pose, &j_delta};
-  ASSERT_TRUE(behind.Evaluate(params, &residual, both));
-  for (double j : j_pose) EXPECT_EQ(j, 0.0);
-  EXPECT_EQ(j_delta, 0.0);
-  j_delta = 1.0;
-  double* delta_only[2] = {nullptr, &j_delta};
-  ASSERT_TRUE(behind.Evaluate(params, &residual, delta_only));
-  EXPECT_EQ(j_delta, 0.0);
-  // Inside the image, only the asked-for block is written.
-  std::fill(j_pose, j_pose + 7, 0.0);
+  const double r0 = 2.0 * (0.01 * u + 0.02 * v + 1);
+  EXPECT_NEAR(residuals[0], r0, 1e-5);
+  EXPECT_DOUBLE_EQ(residuals[1], 60.0);
+  // ... with zero derivatives for the point behind, whichever blocks are asked for.
+  double j_pose[14], j_delta[2] = {1.0, 1.0};
+  std::fill(j_pose, j_pose + 14, 1.0);
+  double* both[2] = {j_pose, j_delta};
+  ASSERT_TRUE(cost.Evaluate(params, residuals, both));
+  for (int a = 7; a < 14; ++a) EXPECT_EQ(j_pose[a], 0.0);
+  EXPECT_EQ(j_delta[1], 0.0);
+  // By hand: ∂r/∂δ = √4 · (0.01·∂u/∂z + 0.02·∂v/∂z) · 10 m/s, ∂u/∂z = −700·1/z², ∂v/∂z = −350/z²;
+  // ∂r/∂t_x = √4 · 0.01 · 700 / z. (Relative 1e-4: the map's slopes come from float samples.)
+  const double z = 20.2;
+  const double dr_ddelta = 2.0 * (0.01 * -700.0 / (z * z) + 0.02 * -350.0 / (z * z)) * 10.0;
+  const double dr_dtx = 2.0 * 0.01 * 700.0 / z;
+  EXPECT_NEAR(j_delta[0], dr_ddelta, 1e-4 * std::abs(dr_ddelta));
+  EXPECT_NEAR(j_pose[4], dr_dtx, 1e-4 * dr_dtx);
+  // Only the asked-for block is written.
+  j_delta[0] = j_delta[1] = 7.0;
   double* pose_only[2] = {j_pose, nullptr};
-  ASSERT_TRUE(cost.Evaluate(params, &residual, pose_only));
+  ASSERT_TRUE(cost.Evaluate(params, residuals, pose_only));
+  EXPECT_EQ(j_delta[0], 7.0);
   EXPECT_NE((Eigen::Map<Eigen::Matrix<double, 7, 1>>(j_pose).norm()), 0.0);
+
+  // The loss per point: Cauchy with scale c, ρ(s) = c²·log(1 + s/c²), ρ'(s) = 1 / (1 + s/c²).
+  // Residuals √ρ'(s_i)·r_i and one more, √Σ(ρ(s_i) − ρ'(s_i)·s_i), so that ½Σr̃² = ½Σρ(s_i).
+  const ceres::CauchyLoss cauchy(1.5);
+  const EdgeAlignmentCost robust =
+      FrameCost({{Eigen::Vector3d(1, 0.5, 20), 4.0, 0}, {Eigen::Vector3d(1, 0.5, -20), 9.0, 1}},
+                twist, -0.01, &camera, map, &cauchy);
+  ASSERT_EQ(robust.num_residuals(), 3);
+  auto rho = [](double s) { return 2.25 * std::log(1 + s / 2.25); };
+  auto rho_prime = [](double s) { return 1 / (1 + s / 2.25); };
+  double robust_residuals[3], j_robust[21], jd_robust[3];
+  double* robust_jacobians[2] = {j_robust, jd_robust};
+  ASSERT_TRUE(robust.Evaluate(params, robust_residuals, robust_jacobians));
+  const double s0 = r0 * r0, s1 = 3600.0;
+  EXPECT_NEAR(robust_residuals[0], std::sqrt(rho_prime(s0)) * r0, 1e-6);
+  EXPECT_NEAR(robust_residuals[1], std::sqrt(rho_prime(s1)) * 60.0, 1e-9);
+  EXPECT_NEAR(robust_residuals[2],
+              std::sqrt(rho(s0) - rho_prime(s0) * s0 + rho(s1) - rho_prime(s1) * s1), 1e-6);
+  double cost_value = 0;
+  for (double r : robust_residuals) cost_value += 0.5 * r * r;
+  EXPECT_NEAR(cost_value, 0.5 * (rho(s0) + rho(s1)), 1e-6);
+  EXPECT_NEAR(j_robust[4], std::sqrt(rho_prime(s0)) * dr_dtx, 1e-4 * dr_dtx);
+  for (int a = 14; a < 21; ++a) EXPECT_EQ(j_robust[a], 0.0);
+  EXPECT_EQ(jd_robust[2], 0.0);
+}
+
+// ½Σr̃² of a cost at (pose, δ).
+double HalfSquaredNorm(const ceres::CostFunction& cost, const double* pose, const double* delta) {
+  std::vector<double> r(cost.num_residuals());
+  const double* params[2] = {pose, delta};
+  EXPECT_TRUE(cost.Evaluate(params, r.data(), nullptr));
+  double sum = 0;
+  for (double x : r) sum += 0.5 * x * x;
+  return sum;
 }
 
 TEST(EdgeAlignmentCost, JacobiansMatchNumericDifferentiation) {
   const SyntheticMap map(1200, 360, [](double u, double v) {
     return 10 + 6 * std::sin(u / 37.0) * std::cos(v / 23.0) + 0.002 * (u - 600) * (v - 100) / 50;
   });
+  // The other edge kind reads a different map.
+  const SyntheticMap other(1200, 360, [](double u, double v) {
+    return 8 + 5 * std::cos(u / 29.0 + v / 41.0) + 0.001 * (u - 300);
+  });
   const CameraModel camera = TestCamera();
+  const ceres::CauchyLoss cauchy(1.0);
+  const ceres::HuberLoss huber(2.0);
+  const ceres::LossFunction* losses[2] = {&cauchy, &huber};
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> unit(-1, 1);
   Eigen::Matrix3d R0;
@@ -188,7 +242,13 @@ TEST(EdgeAlignmentCost, JacobiansMatchNumericDifferentiation) {
   int checked = 0;
   for (int trial = 0; trial < 60; ++trial) {
     const LidarTwist twist = RandomTwist(&rng);
-    const Eigen::Vector3d p(8 + 30 * std::abs(unit(rng)), 8 * unit(rng), 1.5 * unit(rng));
+    // Points that project within 3 px of the border are left out (the residual is not smooth
+    // there); ahead of the camera they land inside.
+    std::vector<EdgeAlignmentCost::Point> points;
+    for (int k = 0; k < 5; ++k) {
+      const Eigen::Vector3d p(8 + 30 * std::abs(unit(rng)), 4 * unit(rng), 1.0 * unit(rng));
+      points.push_back({p, 0.2 + std::abs(unit(rng)), k % 2});
+    }
     const Rigid3d T = PerturbTcameraLidar(MakeRigid(R0, Eigen::Vector3d(0.05, -0.08, -0.27)),
                                           Eigen::Vector3d(unit(rng), unit(rng), unit(rng)),
                                           0.05 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng)));
@@ -199,24 +259,81 @@ TEST(EdgeAlignmentCost, JacobiansMatchNumericDifferentiation) {
     double pose[7] = {s * q.x(),           s * q.y(),           s * q.z(),          s * q.w(),
                       T.translation().x(), T.translation().y(), T.translation().z()};
     double delta = 0.05 * unit(rng);
-    std::unique_ptr<ceres::CostFunction> cost(EdgeAlignmentCost::Create(
-        p, 0.7, twist, 0.02 * unit(rng), &camera, map.interpolator.get(), 20.0));
-    // Skip points that project within 3 px of the border (the residual is not smooth there).
-    double residual;
-    const double* params[2] = {pose, &delta};
-    ASSERT_TRUE(cost->Evaluate(params, &residual, nullptr));
-    if (residual == std::sqrt(0.7) * 20.0) continue;
+    const double e0_s = 0.02 * unit(rng);
+    const std::array<const DistanceInterpolator*, 2> maps = {map.interpolator.get(),
+                                                             other.interpolator.get()};
+    const EdgeAlignmentCost plain(points, twist, e0_s, &camera, maps, 20.0, nullptr);
     // Tolerance: the map is stored in float and the bicubic stencil amplifies its rounding in
     // the finite differences (≈1e-6 relative); the Jacobian itself is exact.
-    EXPECT_LT(WorstTangentJacobianError(*cost, pose, &delta), 1e-4) << "trial " << trial;
-    double j_pose[7], j_delta;
-    double* jacobians[2] = {j_pose, &j_delta};
-    ASSERT_TRUE(cost->Evaluate(params, &residual, jacobians));
-    const Eigen::Map<const Eigen::Vector4d> j_q(j_pose), q_coeffs(pose);
-    EXPECT_LT(std::abs(j_q.dot(q_coeffs)), 1e-9 * std::max(1.0, j_q.norm())) << "trial " << trial;
-    ++checked;
+    EXPECT_LT(WorstTangentJacobianError(plain, pose, &delta), 1e-4) << "trial " << trial;
+    const size_t n = points.size();
+    std::vector<double> r_plain(n), j_plain(7 * n), jd_plain(n);
+    double* plain_jacobians[2] = {j_plain.data(), jd_plain.data()};
+    const double* params[2] = {pose, &delta};
+    ASSERT_TRUE(plain.Evaluate(params, r_plain.data(), plain_jacobians));
+    const Eigen::Map<const Eigen::Vector4d> q_coeffs(pose);
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Map<const Eigen::Vector4d> j_q(j_plain.data() + 7 * i);
+      EXPECT_LT(std::abs(j_q.dot(q_coeffs)), 1e-9 * std::max(1.0, j_q.norm())) << "trial " << trial;
+      checked += j_q.norm() > 0;
+    }
+    // Under a loss: √ρ'(r²) times the plain rows, and J̃ᵀr̃ is the gradient of the cost
+    // ½Σρ(r_i²) (central differences in the tangent space).
+    const ceres::LossFunction* loss = losses[trial % 2];
+    const EdgeAlignmentCost robust(points, twist, e0_s, &camera, maps, 20.0, loss);
+    ASSERT_EQ(robust.num_residuals(), static_cast<int>(n + 1));
+    std::vector<double> r(n + 1), j_pose(7 * (n + 1)), j_delta(n + 1);
+    double* jacobians[2] = {j_pose.data(), j_delta.data()};
+    ASSERT_TRUE(robust.Evaluate(params, r.data(), jacobians));
+    double expected_cost = 0;
+    Eigen::Matrix<double, 8, 1> gradient = Eigen::Matrix<double, 8, 1>::Zero();  // ambient pose, δ
+    for (size_t i = 0; i < n; ++i) {
+      double rho[3];
+      loss->Evaluate(r_plain[i] * r_plain[i], rho);
+      expected_cost += 0.5 * rho[0];
+      const double w = std::sqrt(rho[1]);
+      EXPECT_NEAR(r[i], w * r_plain[i], 1e-12 * r_plain[i]);
+      EXPECT_NEAR(j_delta[i], w * jd_plain[i], 1e-12 * std::max(1.0, std::abs(jd_plain[i])));
+      for (int a = 0; a < 7; ++a) {
+        EXPECT_NEAR(j_pose[7 * i + a], w * j_plain[7 * i + a],
+                    1e-12 * std::max(1.0, std::abs(j_plain[7 * i + a])));
+      }
+    }
+    EXPECT_NEAR(HalfSquaredNorm(robust, pose, &delta), expected_cost, 1e-9 * expected_cost);
+    for (size_t i = 0; i <= n; ++i) {
+      for (int a = 0; a < 7; ++a) gradient[a] += j_pose[7 * i + a] * r[i];
+      gradient[7] += j_delta[i] * r[i];
+    }
+    const ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>
+        manifold;
+    double plus_jacobian[7 * 6];
+    manifold.PlusJacobian(pose, plus_jacobian);
+    const double h = 1e-6;
+    for (int k = 0; k < 7; ++k) {
+      double numeric;
+      if (k < 6) {
+        double step[6] = {0, 0, 0, 0, 0, 0}, plus[7], minus[7];
+        step[k] = h;
+        manifold.Plus(pose, step, plus);
+        step[k] = -h;
+        manifold.Plus(pose, step, minus);
+        numeric = (HalfSquaredNorm(robust, plus, &delta) - HalfSquaredNorm(robust, minus, &delta)) /
+                  (2 * h);
+      } else {
+        double up = delta + h, down = delta - h;
+        numeric =
+            (HalfSquaredNorm(robust, pose, &up) - HalfSquaredNorm(robust, pose, &down)) / (2 * h);
+      }
+      double analytic = gradient[7];
+      if (k < 6) {
+        analytic = 0;
+        for (int a = 0; a < 7; ++a) analytic += gradient[a] * plus_jacobian[a * 6 + k];
+      }
+      EXPECT_NEAR(analytic, numeric, 1e-4 * std::max(1.0, std::abs(numeric)))
+          << "trial " << trial << " tangent " << k;
+    }
   }
-  EXPECT_GT(checked, 30);
+  EXPECT_GT(checked, 150);
 }
 
 TEST(CalibrationPriorCost, NominalValuesAndJacobians) {

@@ -4,6 +4,7 @@
 #include <ceres/product_manifold.h>
 #include <glog/logging.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -59,14 +60,15 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
             ceres::EigenQuaternionManifold(), ceres::SubsetManifold(3, {0, 1, 2})));
   }
   problem.AddParameterBlock(&delta, 1);
-  ceres::LossFunction* loss =
+  // The loss is applied per point inside EdgeAlignmentCost (one residual block per frame).
+  const std::unique_ptr<ceres::LossFunction> loss(
       options.loss == RefineOptions::Loss::kCauchy
           ? static_cast<ceres::LossFunction*>(new ceres::CauchyLoss(options.loss_scale_px))
-          : new ceres::HuberLoss(options.loss_scale_px);
+          : new ceres::HuberLoss(options.loss_scale_px));
   for (const CalibrationFrame* frame : window) {
     if (frame->distance_px[0].empty() || frame->distance_px[1].empty() || frame->size() == 0)
       continue;
-    const DistanceInterpolator* by_kind[2];
+    std::array<const DistanceInterpolator*, 2> by_kind;
     double cap = frame->distance_cap_px;
     for (int kind = 0; kind < 2; ++kind) {
       const cv::Mat& map = frame->distance_px[kind];
@@ -83,17 +85,19 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
     const size_t n = frame->size();
     const size_t keep =
         options.max_points_per_frame > 0 ? std::min<size_t>(n, options.max_points_per_frame) : n;
+    std::vector<EdgeAlignmentCost::Point> points;
     for (size_t k = 0; k < keep; ++k) {
       const size_t i = k * n / keep;
       const double w = frame->kinds[i] == EdgeKind::kHorizontal ? options.horizontal_weight
                                                                 : 1.0 - options.horizontal_weight;
       if (w <= 0) continue;
-      problem.AddResidualBlock(EdgeAlignmentCost::Create(
-                                   frame->points_lidar[i], w, frame->twist, frame->e0_s,
-                                   &frame->camera, by_kind[static_cast<int>(frame->kinds[i])], cap),
-                               loss, pose, &delta);
-      ++result.residuals;
+      points.push_back({frame->points_lidar[i], w, static_cast<int>(frame->kinds[i])});
     }
+    if (points.empty()) continue;
+    result.residuals += static_cast<int>(points.size());
+    problem.AddResidualBlock(new EdgeAlignmentCost(std::move(points), frame->twist, frame->e0_s,
+                                                   &frame->camera, by_kind, cap, loss.get()),
+                             nullptr, pose, &delta);
   }
   if (result.residuals < 20) {
     result.message =

@@ -12,9 +12,10 @@
 namespace stcalib {
 
 // Joint refinement of rotation, translation and time offset over a window of frames with Ceres
-// (method.md §6): one EdgeAlignmentCost per LiDAR edge point under a robust loss, plus a weak
-// CalibrationPriorCost towards the search result. ceres::Covariance then gives per-axis
-// standard deviations; an axis is observable when its std is under a threshold.
+// (method.md §6): one EdgeAlignmentCost per frame (a residual per LiDAR edge point, each under
+// the robust loss), plus a weak CalibrationPriorCost towards the search result.
+// ceres::Covariance then gives per-axis standard deviations; an axis is observable when its std
+// is under a threshold.
 struct RefineOptions {
   enum class Loss { kHuber, kCauchy };
   Loss loss = Loss::kCauchy;
