@@ -194,6 +194,35 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     }
   }
 
+  // The health cache: a window sliding one frame at a time with the estimate unchanged scores
+  // only its newest frame, and every health and best gain equals the uncached one exactly; a
+  // moved estimate, or a frame replaced at the same address by a later one, is scored afresh.
+  {
+    HealthScoreCache cache;
+    auto frame_scorings = [&](const std::vector<const CalibrationFrame*>& w,
+                              const CalibrationState& state) {
+      const int before = cache.frames_scored();
+      WindowScorer uncached(w, ScoreOptions()), cached(w, ScoreOptions());
+      double gain = 0, cached_gain = 0;
+      const double health = HealthScore(&uncached, state, 1.0, 0.05, &gain);
+      EXPECT_EQ(HealthScore(&cached, state, 1.0, 0.05, &cached_gain, &cache), health);
+      EXPECT_EQ(cached_gain, gain);
+      return cache.frames_scored() - before;
+    };
+    EXPECT_EQ(frame_scorings({window[0], window[1], window[2]}, truth), 3);
+    EXPECT_EQ(frame_scorings({window[1], window[2], window[3]}, truth), 1);
+    EXPECT_EQ(frame_scorings({window[2], window[3], window[4]}, truth), 1);
+    EXPECT_EQ(frame_scorings({window[2], window[3], window[4]}, one_off), 3);
+    EXPECT_EQ(frame_scorings({window[3], window[4], window[5]}, one_off), 1);
+    // A frame at the address of window[5] with a later stamp and other points.
+    CalibrationFrame& reused = const_cast<CalibrationFrame&>(*pruned[5]);
+    const CalibrationFrame saved = reused;
+    reused = *pruned[0];
+    reused.camera_time_s = saved.camera_time_s + 1.0;
+    EXPECT_EQ(frame_scorings({window[3], window[4], window[5]}, one_off), 1);
+    reused = saved;
+  }
+
   // Search: coarse-to-fine from 2° on every axis comes back within 0.5° (measured 0.21°; 0.003
   // to 0.21° over the six-frame variants).
   const SearchResult search =

@@ -124,7 +124,8 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   WindowScorer scorer(frames, options_.score);
   report.score_before = scorer.Evaluate(state_, -1);
   report.gray_rate_before = scorer.GrayRate(state_);
-  report.health_before = HealthScore(&scorer, state_);
+  report.health_before = HealthScore(&scorer, state_, kHealthRotationDeg, kHealthTranslationM,
+                                     nullptr, &health_cache_);
   if (options_.wait_for_full_window && static_cast<int>(frames.size()) < options_.window_frames) {
     return KeepEstimate(report, "window filling (" + std::to_string(frames.size()) + " of " +
                                     std::to_string(options_.window_frames) +
@@ -134,10 +135,10 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
                         static_cast<int>(frames.size()) >= options_.window_frames;
   if (tracking && !update_now && ++frames_since_update_ < options_.tracking_update_every) {
     RememberIfHealthy(report.health_before, frames.size());
-    return KeepEstimate(report, "tracking: healthy, next update in " +
-                                    std::to_string(options_.tracking_update_every -
-                                                   frames_since_update_) +
-                                    " frame(s): estimate kept");
+    return KeepEstimate(report,
+                        "tracking: healthy, next update in " +
+                            std::to_string(options_.tracking_update_every - frames_since_update_) +
+                            " frame(s): estimate kept");
   }
   frames_since_update_ = 0;
   // Coarse-to-fine from the widest map when lost or while the window fills, else the finest map.
@@ -218,7 +219,9 @@ void OnlineCalibrator::MeasureEstimate(WindowScorer* scorer, bool moved, FrameRe
   report->score_after = scorer->Evaluate(state_, -1);
   report->gray_rate_after = scorer->GrayRate(state_);
   // The health of an unchanged estimate is the one measured before.
-  report->health = moved ? HealthScore(scorer, state_) : report->health_before;
+  report->health = moved ? HealthScore(scorer, state_, kHealthRotationDeg, kHealthTranslationM,
+                                       nullptr, &health_cache_)
+                         : report->health_before;
   last_health_ = report->health;
 }
 

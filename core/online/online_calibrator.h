@@ -67,8 +67,8 @@ struct OnlineCalibratorOptions {
   // When lost, also search from the last healthy estimate and offer the result as a candidate.
   bool search_from_last_healthy = true;
   // While tracking (not lost; once acquired, a lost update's translation and δ too), an accepted
-  // update moves this share of the way to the new estimate: a first-order filter that averages the scatter of single windows (on a street they
-  // scatter by a few tenths of a degree).
+  // update moves this share of the way to the new estimate: a first-order filter that averages the
+  // scatter of single windows (on a street they scatter by a few tenths of a degree).
   double tracking_gain = 0.3;
   // While tracking (acquisition over, a full window, health at least lost_health), the search
   // and refinement run on every n-th frame only; the frames between join the window and have
@@ -112,12 +112,12 @@ CalibrationState KeepObservableAxes(const CalibrationState& old, const Calibrati
                                     const std::array<bool, kNumAxes>& observable);
 
 // Online calibration (method.md §7): frames in time order; per frame (once acquired, per
-// tracking_update_every frames while healthy) a search step and a refine over the window; an update is taken only when the window score does not get worse and the axes
-// it moves are observable (an unobservable axis keeps its value); |δ| stays within its bound.
-// It only sequences the stages; the maths lives in score/, search/ and refine/.
-// `options` with its shared settings (horizontal_weight, time_offset_bound_s) copied into score,
-// search and refine: the options an OnlineCalibrator runs with. Use it to run a stage alone
-// with the calibrator's settings.
+// tracking_update_every frames while healthy) a search step and a refine over the window; an update
+// is taken only when the window score does not get worse and the axes it moves are observable (an
+// unobservable axis keeps its value); |δ| stays within its bound. It only sequences the stages; the
+// maths lives in score/, search/ and refine/. `options` with its shared settings
+// (horizontal_weight, time_offset_bound_s) copied into score, search and refine: the options an
+// OnlineCalibrator runs with. Use it to run a stage alone with the calibrator's settings.
 OnlineCalibratorOptions WithSharedSettings(const OnlineCalibratorOptions& options);
 
 class OnlineCalibrator {
@@ -212,6 +212,7 @@ class OnlineCalibrator {
   // The rotation grid's per-frame scores: while acquiring the grid runs on a window that grows
   // by one frame, and each frame is scored once as long as the translation and δ stay put.
   RotationGridCache grid_cache_;
+  HealthScoreCache health_cache_;  // the estimate's health, frame by frame
   double last_camera_time_s_ = -std::numeric_limits<double>::infinity();
 };
 

@@ -2,6 +2,7 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -174,6 +175,17 @@ ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& 
 
 std::vector<ScoreValue> WindowScorer::EvaluateStates(const std::vector<CalibrationState>& states,
                                                      int level) {
+  return EvaluateStatesOn(states, level, 0, frames_.size());
+}
+
+std::vector<ScoreValue> WindowScorer::EvaluateStatesOnFrame(
+    size_t f, const std::vector<CalibrationState>& states, int level) {
+  CHECK_LT(f, frames_.size());
+  return EvaluateStatesOn(states, level, f, f + 1);
+}
+
+std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<CalibrationState>& states,
+                                                       int level, size_t begin, size_t end) {
   std::vector<ScoreValue> values(states.size());
   if (states.empty()) return values;
   // Grouped by their rotation (equal matrices share the projection products).
@@ -191,7 +203,7 @@ std::vector<ScoreValue> WindowScorer::EvaluateStates(const std::vector<Calibrati
   double weight_sum = 0;
   std::vector<Eigen::Vector3d> b(states.size());
   std::vector<double> depth_offset(states.size());
-  for (size_t f = 0; f < frames_.size(); ++f) {
+  for (size_t f = begin; f < end; ++f) {
     const CalibrationFrame& cf = *frames_[f];
     const int maps_count = static_cast<int>(cf.score_maps[0].size());
     const int l = level < 0 ? maps_count + level : level;
@@ -251,23 +263,65 @@ std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& fra
   return pruned;
 }
 
+bool HealthScoreCache::Key::operator==(const Key& o) const {
+  return T_camera_lidar == o.T_camera_lidar && time_offset_s == o.time_offset_s &&
+         rotation_deg == o.rotation_deg && translation_m == o.translation_m &&
+         horizontal_weight == o.horizontal_weight && max_points_per_frame == o.max_points_per_frame;
+}
+
 double HealthScore(WindowScorer* scorer, const CalibrationState& state, double rotation_deg,
-                   double translation_m, double* best_gain) {
-  const double centre = scorer->Evaluate(state, -1).score;
-  double best = -std::numeric_limits<double>::infinity();
-  int worse = 0, total = 0;
+                   double translation_m, double* best_gain, HealthScoreCache* cache) {
   const double r = rotation_deg * M_PI / 180.0;
   std::vector<CalibrationState> neighbours;
   for (const Eigen::Matrix<double, 6, 1>& d : NeighbourDirections(true)) {
     neighbours.push_back(Step(state, r * d.head<3>(), translation_m * d.tail<3>(), 0.0));
   }
-  for (const ScoreValue& neighbour : scorer->EvaluateStates(neighbours, -1)) {
-    worse += neighbour.score < centre;
-    best = std::max(best, neighbour.score);
-    ++total;
+  HealthScoreCache local;
+  if (cache == nullptr) cache = &local;
+  const HealthScoreCache::Key key{state.T_camera_lidar.matrix(),
+                                  state.time_offset_s,
+                                  rotation_deg,
+                                  translation_m,
+                                  scorer->options().horizontal_weight,
+                                  scorer->options().max_points_per_frame};
+  if (!(cache->key_ == key)) {
+    cache->key_ = key;
+    cache->frames_.clear();
+  }
+  // The window's frames, from the cache or scored now; frames no longer in the window forgotten.
+  std::vector<HealthScoreCache::Frame> frames;
+  for (size_t f = 0; f < scorer->num_frames(); ++f) {
+    const CalibrationFrame& cf = scorer->frame(f);
+    auto cached = std::find_if(cache->frames_.begin(), cache->frames_.end(), [&](const auto& c) {
+      return c.frame == &cf && c.index == cf.index && c.camera_time_s == cf.camera_time_s;
+    });
+    if (cached != cache->frames_.end()) {
+      frames.push_back(std::move(*cached));
+      continue;
+    }
+    HealthScoreCache::Frame scored{
+        &cf, cf.index, cf.camera_time_s, scorer->EvaluateFrame(f, state, -1).score, {}};
+    for (const ScoreValue& v : scorer->EvaluateStatesOnFrame(f, neighbours, -1)) {
+      scored.neighbours.push_back(v.score);
+    }
+    frames.push_back(std::move(scored));
+    ++cache->frames_scored_;
+  }
+  cache->frames_ = frames;
+  double centre = 0;
+  std::vector<double> window(neighbours.size(), 0.0);
+  for (const HealthScoreCache::Frame& frame : frames) {
+    centre += frame.centre;
+    for (size_t n = 0; n < window.size(); ++n) window[n] += frame.neighbours[n];
+  }
+  double best = -std::numeric_limits<double>::infinity();
+  int worse = 0;
+  for (double neighbour : window) {
+    worse += neighbour < centre;
+    best = std::max(best, neighbour);
   }
   if (best_gain != nullptr) *best_gain = centre > 0 ? best / centre - 1.0 : 0.0;
-  return static_cast<double>(worse) / total;
+  return static_cast<double>(worse) / window.size();
 }
 
 }  // namespace stcalib

@@ -42,6 +42,10 @@ class WindowScorer {
   // share its projection products, so a 728-neighbourhood (27 rotations) costs about half of 728
   // Evaluate() calls.
   std::vector<ScoreValue> EvaluateStates(const std::vector<CalibrationState>& states, int level);
+  // EvaluateStates() on frame `f` alone.
+  std::vector<ScoreValue> EvaluateStatesOnFrame(size_t f,
+                                                const std::vector<CalibrationState>& states,
+                                                int level);
   // Evaluate() on frame `f` alone. The window's score is the sum of these in frame order up to
   // rounding (Evaluate() accumulates point by point across frames).
   ScoreValue EvaluateFrame(size_t f, const CalibrationState& state, int level);
@@ -58,6 +62,9 @@ class WindowScorer {
                         size_t end);
   // Evaluate() over frames [begin, end).
   ScoreValue EvaluateLevel(const CalibrationState& state, int level, size_t begin, size_t end);
+  // EvaluateStates() over frames [begin, end).
+  std::vector<ScoreValue> EvaluateStatesOn(const std::vector<CalibrationState>& states, int level,
+                                           size_t begin, size_t end);
 
   std::vector<const CalibrationFrame*> frames_;
   ScoreOptions options_;
@@ -84,11 +91,47 @@ CalibrationState Step(const CalibrationState& state, const Eigen::Vector3d& rota
 std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& frame,
                                                      const CalibrationState& state, double margin);
 
+// The health score's per-frame scores (centre and 728 neighbours) for one state: an online
+// calibrator whose estimate did not move since the last frame has the same window but for the
+// newest frame, so only that frame is scored again. Frames are known by their address, index and
+// camera stamp (a calibrator's stamps only grow, so a new frame at a freed frame's address is not
+// taken for it).
+class HealthScoreCache {
+ public:
+  int frames_scored() const { return frames_scored_; }  ///< frames scored, not taken from here
+
+ private:
+  friend double HealthScore(WindowScorer*, const CalibrationState&, double, double, double*,
+                            HealthScoreCache*);
+  struct Frame {
+    const CalibrationFrame* frame = nullptr;
+    int index = 0;
+    double camera_time_s = 0;
+    double centre = 0;
+    std::vector<double> neighbours;
+  };
+  struct Key {
+    Eigen::Matrix4d T_camera_lidar = Eigen::Matrix4d::Zero();
+    double time_offset_s = 0, rotation_deg = 0, translation_m = 0, horizontal_weight = 0;
+    int max_points_per_frame = 0;
+    bool operator==(const Key& o) const;
+  };
+  Key key_;
+  std::vector<Frame> frames_;
+  int frames_scored_ = 0;
+};
+
 // Health score (method.md §7): the share of the 728 grid neighbours at ±`rotation_deg` /
-// ±`translation_m` that score worse than `state` on the finest map.
+// ±`translation_m` that score worse than `state` on the finest map. Window scores are the sums
+// of the frames' scores in frame order, so a result from `cache` (optional) is identical to one
+// without it.
 // `best_gain` (optional) receives the largest relative score gain of a neighbour over `state`
 // (score(neighbour) / score(state) − 1; ≤ 0 when `state` beats all of them).
-double HealthScore(WindowScorer* scorer, const CalibrationState& state, double rotation_deg = 1.0,
-                   double translation_m = 0.05, double* best_gain = nullptr);
+constexpr double kHealthRotationDeg = 1.0;
+constexpr double kHealthTranslationM = 0.05;
+double HealthScore(WindowScorer* scorer, const CalibrationState& state,
+                   double rotation_deg = kHealthRotationDeg,
+                   double translation_m = kHealthTranslationM, double* best_gain = nullptr,
+                   HealthScoreCache* cache = nullptr);
 
 }  // namespace stcalib
