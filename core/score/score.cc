@@ -263,7 +263,7 @@ std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& fra
   return pruned;
 }
 
-bool HealthScoreCache::Key::operator==(const Key& o) const {
+bool HealthSetting::operator==(const HealthSetting& o) const {
   return T_camera_lidar == o.T_camera_lidar && time_offset_s == o.time_offset_s &&
          rotation_deg == o.rotation_deg && translation_m == o.translation_m &&
          horizontal_weight == o.horizontal_weight && max_points_per_frame == o.max_points_per_frame;
@@ -277,51 +277,34 @@ double HealthScore(WindowScorer* scorer, const CalibrationState& state, double r
     neighbours.push_back(Step(state, r * d.head<3>(), translation_m * d.tail<3>(), 0.0));
   }
   HealthScoreCache local;
-  if (cache == nullptr) cache = &local;
-  const HealthScoreCache::Key key{state.T_camera_lidar.matrix(),
-                                  state.time_offset_s,
-                                  rotation_deg,
-                                  translation_m,
-                                  scorer->options().horizontal_weight,
-                                  scorer->options().max_points_per_frame};
-  if (!(cache->key_ == key)) {
-    cache->key_ = key;
-    cache->frames_.clear();
+  // Per frame: the centre's score, then the neighbours'. Window scores are sums over the frames
+  // in frame order, cached or not.
+  const std::vector<const std::vector<double>*> frames =
+      (cache != nullptr ? cache : &local)
+          ->FrameScores(
+              *scorer,
+              {state.T_camera_lidar.matrix(), state.time_offset_s, rotation_deg, translation_m,
+               scorer->options().horizontal_weight, scorer->options().max_points_per_frame},
+              [&](size_t f) {
+                std::vector<double> scores = {scorer->EvaluateFrame(f, state, -1).score};
+                for (const ScoreValue& v : scorer->EvaluateStatesOnFrame(f, neighbours, -1)) {
+                  scores.push_back(v.score);
+                }
+                return scores;
+              });
+  std::vector<double> window(neighbours.size() + 1, 0.0);
+  for (const std::vector<double>* frame : frames) {
+    for (size_t i = 0; i < window.size(); ++i) window[i] += (*frame)[i];
   }
-  // The window's frames, from the cache or scored now; frames no longer in the window forgotten.
-  std::vector<HealthScoreCache::Frame> frames;
-  for (size_t f = 0; f < scorer->num_frames(); ++f) {
-    const CalibrationFrame& cf = scorer->frame(f);
-    auto cached = std::find_if(cache->frames_.begin(), cache->frames_.end(), [&](const auto& c) {
-      return c.frame == &cf && c.index == cf.index && c.camera_time_s == cf.camera_time_s;
-    });
-    if (cached != cache->frames_.end()) {
-      frames.push_back(std::move(*cached));
-      continue;
-    }
-    HealthScoreCache::Frame scored{
-        &cf, cf.index, cf.camera_time_s, scorer->EvaluateFrame(f, state, -1).score, {}};
-    for (const ScoreValue& v : scorer->EvaluateStatesOnFrame(f, neighbours, -1)) {
-      scored.neighbours.push_back(v.score);
-    }
-    frames.push_back(std::move(scored));
-    ++cache->frames_scored_;
-  }
-  cache->frames_ = frames;
-  double centre = 0;
-  std::vector<double> window(neighbours.size(), 0.0);
-  for (const HealthScoreCache::Frame& frame : frames) {
-    centre += frame.centre;
-    for (size_t n = 0; n < window.size(); ++n) window[n] += frame.neighbours[n];
-  }
+  const double centre = window[0];
   double best = -std::numeric_limits<double>::infinity();
   int worse = 0;
-  for (double neighbour : window) {
-    worse += neighbour < centre;
-    best = std::max(best, neighbour);
+  for (size_t n = 1; n < window.size(); ++n) {
+    worse += window[n] < centre;
+    best = std::max(best, window[n]);
   }
   if (best_gain != nullptr) *best_gain = centre > 0 ? best / centre - 1.0 : 0.0;
-  return static_cast<double>(worse) / window.size();
+  return static_cast<double>(worse) / neighbours.size();
 }
 
 }  // namespace stcalib

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/score/calibration_frame.h"
+#include "core/score/frame_score_cache.h"
 #include "core/types/calibration.h"
 
 namespace stcalib {
@@ -91,35 +92,16 @@ CalibrationState Step(const CalibrationState& state, const Eigen::Vector3d& rota
 std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& frame,
                                                      const CalibrationState& state, double margin);
 
-// The health score's per-frame scores (centre and 728 neighbours) for one state: an online
-// calibrator whose estimate did not move since the last frame has the same window but for the
-// newest frame, so only that frame is scored again. Frames are known by their address, index and
-// camera stamp (a calibrator's stamps only grow, so a new frame at a freed frame's address is not
-// taken for it).
-class HealthScoreCache {
- public:
-  int frames_scored() const { return frames_scored_; }  ///< frames scored, not taken from here
-
- private:
-  friend double HealthScore(WindowScorer*, const CalibrationState&, double, double, double*,
-                            HealthScoreCache*);
-  struct Frame {
-    const CalibrationFrame* frame = nullptr;
-    int index = 0;
-    double camera_time_s = 0;
-    double centre = 0;
-    std::vector<double> neighbours;
-  };
-  struct Key {
-    Eigen::Matrix4d T_camera_lidar = Eigen::Matrix4d::Zero();
-    double time_offset_s = 0, rotation_deg = 0, translation_m = 0, horizontal_weight = 0;
-    int max_points_per_frame = 0;
-    bool operator==(const Key& o) const;
-  };
-  Key key_;
-  std::vector<Frame> frames_;
-  int frames_scored_ = 0;
+// What the health score's per-frame scores depend on besides the frame. With a
+// HealthScoreCache, an online calibrator whose estimate did not move since the last frame scores
+// only the newest frame of its sliding window.
+struct HealthSetting {
+  Eigen::Matrix4d T_camera_lidar;
+  double time_offset_s, rotation_deg, translation_m, horizontal_weight;
+  int max_points_per_frame;
+  bool operator==(const HealthSetting& o) const;
 };
+using HealthScoreCache = FrameScoreCache<HealthSetting>;  // per frame: centre, 728 neighbours
 
 // Health score (method.md §7): the share of the 728 grid neighbours at ±`rotation_deg` /
 // ±`translation_m` that score worse than `state` on the finest map. Window scores are the sums

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 
 namespace stcalib {
 namespace {
@@ -148,7 +147,7 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
   return result;
 }
 
-bool RotationGridCache::Lattice::operator==(const Lattice& o) const {
+bool RotationGridLattice::operator==(const RotationGridLattice& o) const {
   return center == o.center && center_time_offset_s == o.center_time_offset_s &&
          half_range_deg == o.half_range_deg && step_deg == o.step_deg && level == o.level &&
          horizontal_weight == o.horizontal_weight &&
@@ -176,45 +175,22 @@ RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationSta
     }
   }
   RotationGridCache local;
-  if (cache == nullptr) cache = &local;
-  RotationGridCache::Lattice lattice{center.T_camera_lidar.matrix(),
-                                     center.time_offset_s,
-                                     half_range_deg,
-                                     step_deg,
-                                     level,
-                                     scorer->options().horizontal_weight,
-                                     scorer->options().max_points_per_frame,
-                                     std::move(in_bounds)};
-  if (!cache->lattice_ || !(*cache->lattice_ == lattice)) {
-    cache->scores_.clear();
-    cache->lattice_ = std::move(lattice);
-  }
-  const std::vector<uint8_t>& mask = cache->lattice_->in_bounds;
-  // Per-frame scores, from the cache or computed; frames no longer in the window forgotten.
-  auto score_frame = [&](size_t f) {
-    std::vector<double> scores(points.size(), 0.0);
-    for (size_t i = 0; i < points.size(); ++i) {
-      if (mask[i]) scores[i] = scorer->EvaluateFrame(f, points[i], level).score;
-    }
-    ++cache->frames_scored_;
-    return scores;
-  };
-  std::map<RotationGridCache::FrameKey, std::vector<double>> kept;
-  std::deque<std::vector<double>> duplicates;  // frames whose key an earlier one took
-  std::vector<const std::vector<double>*> frame_scores;
-  for (size_t f = 0; f < scorer->num_frames(); ++f) {
-    const CalibrationFrame& frame = scorer->frame(f);
-    const RotationGridCache::FrameKey key{frame.index, frame.camera_time_s, frame.size()};
-    if (kept.count(key) > 0) {
-      duplicates.push_back(score_frame(f));
-      frame_scores.push_back(&duplicates.back());
-      continue;
-    }
-    auto it = cache->scores_.find(key);
-    std::vector<double> scores =
-        it != cache->scores_.end() ? std::move(it->second) : score_frame(f);
-    frame_scores.push_back(&kept.emplace(key, std::move(scores)).first->second);
-  }
+  const std::vector<uint8_t> mask = in_bounds;
+  // Per-frame scores, from the cache or computed.
+  const std::vector<const std::vector<double>*> frame_scores =
+      (cache != nullptr ? cache : &local)
+          ->FrameScores(*scorer,
+                        {center.T_camera_lidar.matrix(), center.time_offset_s, half_range_deg,
+                         step_deg, level, scorer->options().horizontal_weight,
+                         scorer->options().max_points_per_frame, std::move(in_bounds)},
+                        [&](size_t f) {
+                          std::vector<double> scores(points.size(), 0.0);
+                          for (size_t i = 0; i < points.size(); ++i) {
+                            if (mask[i])
+                              scores[i] = scorer->EvaluateFrame(f, points[i], level).score;
+                          }
+                          return scores;
+                        });
   RotationGridResult result;
   for (size_t i = 0; i < points.size(); ++i) {
     if (!mask[i]) continue;
@@ -226,7 +202,6 @@ RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationSta
       result.state = points[i];
     }
   }
-  cache->scores_ = std::move(kept);
   return result;
 }
 

@@ -2,10 +2,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <map>
-#include <optional>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "core/score/score.h"
@@ -73,46 +70,19 @@ struct RotationGridResult {
   int evaluations = 0;     ///< lattice points compared (scored now or taken from the cache)
 };
 
-// Per-frame scores of RotationGridSearch's lattice, kept from one call to the next. While
-// acquiring, the calibrator runs the grid on a window that grows by one frame per call; as long
-// as the lattice (centre, range, step, level, which points lie within the bounds) and the score
-// options stay the same, a frame scored by an earlier call is not scored again. A frame is known
-// by its index, camera stamp and number of points, so a caller must not change a frame's content
-// under the same key (the calibrator's frames are pruned once, when they arrive, and then const).
-// Two frames with the same key in one window are each scored, never shared. Frames that left the
-// window are forgotten.
-class RotationGridCache {
- public:
-  // Frames scored over the whole lattice since construction (the work the cache did not save).
-  int frames_scored() const { return frames_scored_; }
-
- private:
-  friend RotationGridResult RotationGridSearch(WindowScorer*, const CalibrationState&,
-                                               const CalibrationState&,
-                                               const AdaptiveGridSearchOptions&, double, double,
-                                               int, RotationGridCache*);
-  struct FrameKey {
-    int index;
-    double camera_time_s;
-    size_t points;
-    bool operator<(const FrameKey& o) const {
-      return std::tie(index, camera_time_s, points) < std::tie(o.index, o.camera_time_s, o.points);
-    }
-  };
-  // What the per-frame scores depend on besides the frame; compared exactly.
-  struct Lattice {
-    Eigen::Matrix4d center;
-    double center_time_offset_s, half_range_deg, step_deg;
-    int level;
-    double horizontal_weight;
-    int max_points_per_frame;
-    std::vector<uint8_t> in_bounds;  // per lattice point
-    bool operator==(const Lattice& o) const;
-  };
-  std::optional<Lattice> lattice_;  // the lattice the scores belong to; none before the first
-  std::map<FrameKey, std::vector<double>> scores_;  // per lattice point (0 when out of bounds)
-  int frames_scored_ = 0;
+// What the per-frame scores of RotationGridSearch's lattice depend on besides the frame. While
+// acquiring, the calibrator runs the grid on a window that grows by one frame per call; with a
+// RotationGridCache a frame scored by an earlier call over the same lattice is not scored again.
+struct RotationGridLattice {
+  Eigen::Matrix4d center;
+  double center_time_offset_s, half_range_deg, step_deg;
+  int level;
+  double horizontal_weight;
+  int max_points_per_frame;
+  std::vector<uint8_t> in_bounds;  // per lattice point
+  bool operator==(const RotationGridLattice& o) const;
 };
+using RotationGridCache = FrameScoreCache<RotationGridLattice>;  // per lattice point (0 outside)
 
 // `cache` (optional): reuse the per-frame scores of earlier calls (see RotationGridCache). The
 // result is the same with or without it: the window's score at a lattice point is the sum of
