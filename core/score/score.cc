@@ -9,25 +9,45 @@
 namespace stcalib {
 namespace {
 
-// Bilinear sample of a CV_32F map; 0 outside.
-inline float Sample(const cv::Mat& map, double u, double v) {
-  if (!(u >= 0 && v >= 0 && u < map.cols - 1 && v < map.rows - 1)) return 0.0f;
+// A CV_32F map with its limits as doubles (converted once, not per sample).
+struct MapView {
+  explicit MapView(const cv::Mat& map)
+      : data(map.ptr<float>(0)),
+        step(map.step1()),
+        cols(map.cols),
+        rows(map.rows),
+        last_col(map.cols - 1),
+        last_row(map.rows - 1) {
+    CHECK_EQ(map.type(), CV_32F);
+  }
+  const float* data;
+  size_t step;  // floats per row
+  double cols, rows, last_col, last_row;
+};
+
+// Bilinear sample of a map; 0 outside.
+inline float Sample(const MapView& map, double u, double v) {
+  if (!(u >= 0 && v >= 0 && u < map.last_col && v < map.last_row)) return 0.0f;
   const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
   const float fu = static_cast<float>(u - u0), fv = static_cast<float>(v - v0);
-  const float* row0 = map.ptr<float>(v0);
-  const float* row1 = map.ptr<float>(v0 + 1);
+  const float* row0 = map.data + v0 * map.step;
+  const float* row1 = row0 + map.step;
   return (1 - fv) * ((1 - fu) * row0[u0] + fu * row0[u0 + 1]) +
          fv * ((1 - fu) * row1[u0] + fu * row1[u0 + 1]);
 }
 
-// One point's share of a score: the map at the projection of h = K·R_rect·p_camera + p4,
-// weighted, and whether it landed in the image.
-inline void AddProjection(const Eigen::Vector3d& h, const cv::Mat& map, float w,
-                          ScoreValue* value) {
-  const double u = h.x() / h.z(), v = h.y() / h.z();
+// One point's share of a score: the map at its pixel (u, v), weighted, and whether it landed in
+// the image.
+inline void AddSample(double u, double v, const MapView& map, float w, ScoreValue* value) {
   const float s = Sample(map, u, v);
   if (u >= 0 && v >= 0 && u < map.cols && v < map.rows) ++value->projected;
   value->score += w * s;
+}
+
+// The same at the projection of h = K·R_rect·p_camera + p4.
+inline void AddProjection(const Eigen::Vector3d& h, const MapView& map, float w,
+                          ScoreValue* value) {
+  AddSample(h.x() / h.z(), h.y() / h.z(), map, w, value);
 }
 
 }  // namespace
@@ -152,7 +172,7 @@ ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& 
   double weight_sum = 0;
   for (size_t f = begin; f < end; ++f) {
     const CalibrationFrame& cf = *frames_[f];
-    const cv::Mat* maps[2] = {&map_of(cf, 0), &map_of(cf, 1)};
+    const MapView maps[2] = {MapView(map_of(cf, 0)), MapView(map_of(cf, 1))};
     const std::vector<Eigen::Vector3d>& moved = Moved(f, state.time_offset_s);
     // h = K·R_rect·(R·p + t) + p4 = M·p + b.
     const Eigen::Matrix3d KR = cf.camera.P_rect_02.leftCols<3>() * cf.camera.R_rect_00;
@@ -165,7 +185,7 @@ ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& 
       weight_sum += w;
       if (depth_row.dot(moved[k]) + depth_offset < cf.camera.min_depth_m) continue;
       const Eigen::Vector3d h = M * moved[k] + b;
-      AddProjection(h, *maps[kinds_[f][k]], w, &value);
+      AddProjection(h, maps[kinds_[f][k]], w, &value);
     }
   }
   value.gray_rate = weight_sum > 0 ? value.score / 255.0 / weight_sum : 0.0;
@@ -200,6 +220,17 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
     if (g == groups.size()) groups.emplace_back();
     groups[g].push_back(n);
   }
+  size_t largest_group = 0;
+  for (const std::vector<size_t>& group : groups)
+    largest_group = std::max(largest_group, group.size());
+  struct Lanes {
+    std::vector<double> bx, by, bz, depth_offset, u, v;
+    std::vector<uint8_t> in_front;
+  } lane;
+  for (auto* a : {&lane.bx, &lane.by, &lane.bz, &lane.depth_offset, &lane.u, &lane.v}) {
+    a->resize(largest_group);
+  }
+  lane.in_front.resize(largest_group);
   double weight_sum = 0;
   std::vector<Eigen::Vector3d> b(states.size());
   std::vector<double> depth_offset(states.size());
@@ -209,7 +240,7 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
     const int l = level < 0 ? maps_count + level : level;
     CHECK(l >= 0 && l < maps_count && l < static_cast<int>(cf.score_maps[1].size()))
         << "score level " << level << " of " << maps_count;
-    const cv::Mat* maps[2] = {&cf.score_maps[0][l], &cf.score_maps[1][l]};
+    const MapView maps[2] = {MapView(cf.score_maps[0][l]), MapView(cf.score_maps[1][l])};
     const std::vector<Eigen::Vector3d>& moved = Moved(f, states[0].time_offset_s);
     for (size_t k = 0; k < moved.size(); ++k) weight_sum += weights_[f][k];
     // As EvaluateOn: h = M·p + b, depth = depth_row·p + depth_offset.
@@ -223,15 +254,28 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
       const Eigen::Matrix3d& R = states[group.front()].T_camera_lidar.linear();
       const Eigen::Matrix3d M = KR * R;
       const Eigen::Vector3d depth_row = cf.camera.R_rect_00.row(2) * R;
+      // The group's translations as arrays, so that the projection of a point under all of them
+      // is one vectorised loop; then the samples. Each state still sums its points in order.
+      const size_t m = group.size();
+      for (size_t j = 0; j < m; ++j) {
+        lane.bx[j] = b[group[j]].x();
+        lane.by[j] = b[group[j]].y();
+        lane.bz[j] = b[group[j]].z();
+        lane.depth_offset[j] = depth_offset[group[j]];
+      }
       for (size_t k = 0; k < moved.size(); ++k) {
         const float w = weights_[f][k];
         const double depth = depth_row.dot(moved[k]);
         const Eigen::Vector3d Mp = M * moved[k];
-        const cv::Mat& map = *maps[kinds_[f][k]];
-        for (size_t n : group) {
-          if (depth + depth_offset[n] < cf.camera.min_depth_m) continue;
-          const Eigen::Vector3d h = Mp + b[n];
-          AddProjection(h, map, w, &values[n]);
+        const MapView& map = maps[kinds_[f][k]];
+        for (size_t j = 0; j < m; ++j) {
+          const double hz = Mp.z() + lane.bz[j];
+          lane.u[j] = (Mp.x() + lane.bx[j]) / hz;
+          lane.v[j] = (Mp.y() + lane.by[j]) / hz;
+          lane.in_front[j] = !(depth + lane.depth_offset[j] < cf.camera.min_depth_m);
+        }
+        for (size_t j = 0; j < m; ++j) {
+          if (lane.in_front[j]) AddSample(lane.u[j], lane.v[j], map, w, &values[group[j]]);
         }
       }
     }
