@@ -232,8 +232,6 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
   }
   lane.in_front.resize(largest_group);
   double weight_sum = 0;
-  std::vector<Eigen::Vector3d> b(states.size());
-  std::vector<double> depth_offset(states.size());
   for (size_t f = begin; f < end; ++f) {
     const CalibrationFrame& cf = *frames_[f];
     const int maps_count = static_cast<int>(cf.score_maps[0].size());
@@ -245,11 +243,6 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
     for (size_t k = 0; k < moved.size(); ++k) weight_sum += weights_[f][k];
     // As EvaluateOn: h = M·p + b, depth = depth_row·p + depth_offset.
     const Eigen::Matrix3d KR = cf.camera.P_rect_02.leftCols<3>() * cf.camera.R_rect_00;
-    for (size_t n = 0; n < states.size(); ++n) {
-      const Rigid3d& T = states[n].T_camera_lidar;
-      b[n] = KR * T.translation() + cf.camera.P_rect_02.col(3);
-      depth_offset[n] = cf.camera.R_rect_00.row(2).dot(T.translation());
-    }
     for (const std::vector<size_t>& group : groups) {
       const Eigen::Matrix3d& R = states[group.front()].T_camera_lidar.linear();
       const Eigen::Matrix3d M = KR * R;
@@ -258,10 +251,12 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
       // is one vectorised loop; then the samples. Each state still sums its points in order.
       const size_t m = group.size();
       for (size_t j = 0; j < m; ++j) {
-        lane.bx[j] = b[group[j]].x();
-        lane.by[j] = b[group[j]].y();
-        lane.bz[j] = b[group[j]].z();
-        lane.depth_offset[j] = depth_offset[group[j]];
+        const Eigen::Vector3d& t = states[group[j]].T_camera_lidar.translation();
+        const Eigen::Vector3d b = KR * t + cf.camera.P_rect_02.col(3);
+        lane.bx[j] = b.x();
+        lane.by[j] = b.y();
+        lane.bz[j] = b.z();
+        lane.depth_offset[j] = cf.camera.R_rect_00.row(2).dot(t);
       }
       for (size_t k = 0; k < moved.size(); ++k) {
         const float w = weights_[f][k];
@@ -316,13 +311,14 @@ bool HealthSetting::operator==(const HealthSetting& o) const {
 double HealthScore(WindowScorer* scorer, const CalibrationState& state, double rotation_deg,
                    double translation_m, double* best_gain, HealthScoreCache* cache) {
   const double r = rotation_deg * M_PI / 180.0;
-  std::vector<CalibrationState> neighbours;
+  // The centre first, then its neighbours, all scored in one pass per frame (EvaluateStates
+  // equals Evaluate bit for bit). Window scores are sums over the frames in frame order, cached
+  // or not.
+  std::vector<CalibrationState> states = {state};
   for (const Eigen::Matrix<double, 6, 1>& d : NeighbourDirections(true)) {
-    neighbours.push_back(Step(state, r * d.head<3>(), translation_m * d.tail<3>(), 0.0));
+    states.push_back(Step(state, r * d.head<3>(), translation_m * d.tail<3>(), 0.0));
   }
   HealthScoreCache local;
-  // Per frame: the centre's score, then the neighbours'. Window scores are sums over the frames
-  // in frame order, cached or not.
   const std::vector<const std::vector<double>*> frames =
       (cache != nullptr ? cache : &local)
           ->FrameScores(
@@ -330,13 +326,13 @@ double HealthScore(WindowScorer* scorer, const CalibrationState& state, double r
               {state.T_camera_lidar.matrix(), state.time_offset_s, rotation_deg, translation_m,
                scorer->options().horizontal_weight, scorer->options().max_points_per_frame},
               [&](size_t f) {
-                std::vector<double> scores = {scorer->EvaluateFrame(f, state, -1).score};
-                for (const ScoreValue& v : scorer->EvaluateStatesOnFrame(f, neighbours, -1)) {
+                std::vector<double> scores;
+                for (const ScoreValue& v : scorer->EvaluateStatesOnFrame(f, states, -1)) {
                   scores.push_back(v.score);
                 }
                 return scores;
               });
-  std::vector<double> window(neighbours.size() + 1, 0.0);
+  std::vector<double> window(states.size(), 0.0);
   for (const std::vector<double>* frame : frames) {
     for (size_t i = 0; i < window.size(); ++i) window[i] += (*frame)[i];
   }
@@ -348,7 +344,7 @@ double HealthScore(WindowScorer* scorer, const CalibrationState& state, double r
     best = std::max(best, window[n]);
   }
   if (best_gain != nullptr) *best_gain = centre > 0 ? best / centre - 1.0 : 0.0;
-  return static_cast<double>(worse) / neighbours.size();
+  return static_cast<double>(worse) / (states.size() - 1);
 }
 
 }  // namespace stcalib
