@@ -18,11 +18,11 @@ int RunSimulate() {
   options.lidar_hz = FLAGS_lidar_hz;
   if (!sim::ParseSceneType(FLAGS_scene, &options.scene)) {
     return UsageError("simulate",
-                      "--scene must be urban, poles or open, got '" + FLAGS_scene + "'");
+                      "--scene must be " + sim::SceneTypeChoices() + ", got '" + FLAGS_scene + "'");
   }
   if (!sim::ParseSimCamera(FLAGS_camera, &options.camera)) {
-    return UsageError("simulate",
-                      "--camera must be kitti, kitti_1003 or hd720, got '" + FLAGS_camera + "'");
+    return UsageError(
+        "simulate", "--camera must be " + sim::SimCameraChoices() + ", got '" + FLAGS_camera + "'");
   }
   const Status valid = options.Validate();
   if (!valid.ok()) return UsageError("simulate", valid.message());

@@ -459,6 +459,11 @@ TEST(Cli, SimulateRejectsBadFlags) {
     EXPECT_EQ(r.exit_code, 2) << flags << ": " << r.output;
     EXPECT_THAT(r.output, HasSubstr("usage error")) << flags;
   }
+  // Unknown names are answered with the names the simulator knows.
+  EXPECT_THAT(RunStcalib("simulate" + out + " --scene=forest").output,
+              HasSubstr("--scene must be urban, poles or open, got 'forest'"));
+  EXPECT_THAT(RunStcalib("simulate" + out + " --camera=fisheye").output,
+              HasSubstr("--camera must be kitti, kitti_1003 or hd720, got 'fisheye'"));
   EXPECT_FALSE(std::filesystem::exists(tmp.path() + "/o"));
   EXPECT_EQ(RunStcalib("simulate --frames=2").exit_code, 2);  // no --out
   testing::WriteFile(tmp.path() + "/file", "x");

@@ -31,4 +31,15 @@ std::string EnumName(const EnumNames<Enum, N>& names, Enum value) {
   return "?";
 }
 
+// The table's names for a message: "a, b or c".
+template <typename Enum, size_t N>
+std::string EnumNameChoices(const EnumNames<Enum, N>& names) {
+  std::string text;
+  for (size_t i = 0; i < N; ++i) {
+    if (i > 0) text += i + 1 < N ? ", " : " or ";
+    text += names[i].second;
+  }
+  return text;
+}
+
 }  // namespace stcalib::sim

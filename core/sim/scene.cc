@@ -145,6 +145,8 @@ bool ParseSceneType(const std::string& name, SceneType* type) {
 
 std::string SceneTypeName(SceneType type) { return EnumName(kSceneNames, type); }
 
+std::string SceneTypeChoices() { return EnumNameChoices(kSceneNames); }
+
 double CellNoise(const Eigen::Vector3d& p, double cell_m) {
   uint64_t h = 0x9E3779B97F4A7C15ULL;
   for (int k = 0; k < 3; ++k) {

@@ -14,6 +14,7 @@ namespace stcalib::sim {
 enum class SceneType { kUrban, kPoles, kOpen };
 bool ParseSceneType(const std::string& name, SceneType* type);
 std::string SceneTypeName(SceneType type);
+std::string SceneTypeChoices();  ///< "urban, poles or open"
 
 enum class Texture : uint8_t { kPlain, kFoliage, kAsphalt, kFacade };
 

@@ -108,6 +108,8 @@ bool ParseSimCamera(const std::string& name, SimCamera* camera) {
 
 std::string SimCameraName(SimCamera camera) { return EnumName(kCameraNames, camera); }
 
+std::string SimCameraChoices() { return EnumNameChoices(kCameraNames); }
+
 CameraRig MakeCameraRig(SimCamera camera) {
   CameraRig rig;
   switch (camera) {

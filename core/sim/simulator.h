@@ -27,6 +27,7 @@ enum class SimCamera {
 };
 bool ParseSimCamera(const std::string& name, SimCamera* camera);
 std::string SimCameraName(SimCamera camera);
+std::string SimCameraChoices();  ///< "kitti, kitti_1003 or hd720"
 // Intrinsics, rectification and size of `camera` (pose, sun and noise keep their defaults).
 CameraRig MakeCameraRig(SimCamera camera);
 
