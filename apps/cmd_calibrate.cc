@@ -16,6 +16,7 @@
 #include "apps/flags.h"
 #include "apps/plot.h"
 #include "core/io/image.h"
+#include "core/io/kitti_calib.h"
 #include "core/io/text.h"
 #include "core/online/convergence.h"
 #include "core/search/adaptive_grid_search.h"
@@ -41,14 +42,6 @@ nlohmann::json ErrorJson(const CalibrationError& e) {
           {"y_m", e.translation_m.y()},
           {"z_m", e.translation_m.z()},
           {"time_offset_s", e.time_offset_s}};
-}
-
-// Roll, pitch, yaw [deg] of R = Rz(yaw)·Ry(pitch)·Rx(roll).
-Eigen::Vector3d EulerRpyDeg(const Eigen::Matrix3d& R) {
-  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-  const double roll = std::atan2(R(2, 1), R(2, 2));
-  const double yaw = std::atan2(R(1, 0), R(0, 0));
-  return Eigen::Vector3d(roll, pitch, yaw) * 180.0 / M_PI;
 }
 
 cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
@@ -155,7 +148,6 @@ CalibrateJob CalibrateJobFromFlags() {
 
 int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const char* kCommand = "calibrate";
-  if (job.out_dir.empty()) return UsageError(kCommand, "--out=DIR is required");
   Status status = job.online.Validate();
   if (!status.ok()) return UsageError(kCommand, status.message());
   Drive drive;
@@ -205,9 +197,11 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       source->motion().source() == DriveMotion::Source::kOxts ? "oxts" : "scan_registration";
 
   std::error_code ec;
-  fs::create_directories(job.out_dir, ec);
-  if (ec || !fs::is_directory(job.out_dir)) {
-    return ReportError(kCommand, Status::Error(job.out_dir + ": cannot create output folder"));
+  if (!job.out_dir.empty()) {
+    fs::create_directories(job.out_dir, ec);
+    if (ec || !fs::is_directory(job.out_dir)) {
+      return ReportError(kCommand, Status::Error(job.out_dir + ": cannot create output folder"));
+    }
   }
 
   OnlineCalibrator calibrator(job.online, initial);
@@ -310,9 +304,16 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   // The covariance is the refinement the verdict read (the polish holds the translation).
   const RefineResult& refine = verdict.refine;
 
-  // Outputs.
+  // Outputs (method.md §9: --out is optional; without it nothing is written and the caller
+  // prints the estimate).
   const std::string out = job.out_dir;
   auto fail = [&](const Status& s) { return ReportError(kCommand, s); };
+  auto verdict_code = [&]() {
+    if (outcome->converged) return kExitOk;
+    std::fprintf(stderr, "stcalib calibrate: %s\n", outcome->reason.c_str());
+    return kExitFailure;
+  };
+  if (out.empty()) return verdict_code();
   if (outcome->converged) {
     status = WriteVeloToCam(out + "/calib_velo_to_cam.txt", outcome->estimate.T_camera_lidar);
     if (!status.ok()) return fail(status);
@@ -331,7 +332,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
         refine.covariance_ok ? nlohmann::json(refine.std_dev[k]) : nlohmann::json(nullptr);
     observable_json[kAxisNames[k]] = refine.observable[k];
   }
-  const Eigen::Vector3d rpy_deg = EulerRpyDeg(outcome->estimate.T_camera_lidar.linear());
+  const Eigen::Vector3d rpy_deg = MountRollPitchYawDeg(outcome->estimate.T_camera_lidar.linear());
   // Per frame, over all frames (those without an update count as 0 ms), and per update.
   double search_ms = 0, refine_ms = 0, update_ms = 0;
   int updates = 0;
@@ -394,7 +395,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   std::vector<double> xs, rot_err, trans_err_cm, dt_ms, roll_e, pitch_e, yaw_e;
   for (const FrameReport& r : outcome->reports) {
     const CalibrationError e = ComputeCalibrationError(r.after, outcome->reference_state);
-    const Eigen::Vector3d rpy = EulerRpyDeg(r.after.T_camera_lidar.linear());
+    const Eigen::Vector3d rpy = MountRollPitchYawDeg(r.after.T_camera_lidar.linear());
     char row[512];
     std::snprintf(
         row, sizeof(row),
@@ -466,11 +467,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     if (!status.ok()) return fail(status);
     outcome->pictures.push_back(out + "/" + name);
   }
-  if (!outcome->converged) {
-    std::fprintf(stderr, "stcalib calibrate: %s\n", outcome->reason.c_str());
-    return kExitFailure;
-  }
-  return kExitOk;
+  return verdict_code();
 }
 
 int RunCalibrate() {
@@ -489,7 +486,14 @@ int RunCalibrate() {
       outcome.has_truth ? "error vs ground truth" : "agreement with the drive calibration",
       e.rotation_deg, e.roll_deg, e.pitch_deg, e.yaw_deg, e.translation_norm_m,
       1000 * e.time_offset_s, 1000 * outcome.estimate.time_offset_s);
-  std::printf("mean %.1f ms per frame; outputs in %s\n", outcome.mean_frame_ms, FLAGS_out.c_str());
+  if (!FLAGS_out.empty()) {
+    std::printf("mean %.1f ms per frame; outputs in %s\n", outcome.mean_frame_ms,
+                FLAGS_out.c_str());
+  } else if (outcome.converged) {  // no --out: the estimate on stdout, nothing written
+    std::printf("mean %.1f ms per frame; no --out, so the estimate is printed here:\n%s",
+                outcome.mean_frame_ms, VeloToCamText(outcome.estimate.T_camera_lidar).c_str());
+    std::printf("time_offset_s: %.9f\n", outcome.estimate.time_offset_s);
+  }
   return code;
 }
 

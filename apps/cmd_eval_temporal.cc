@@ -86,7 +86,8 @@ cv::Mat Curves(const TemporalEvalResult& r) {
 
 int RunEvalTemporal() {
   const char* kCommand = "eval-temporal";
-  if (FLAGS_out.empty()) return UsageError(kCommand, "--out=DIR is required");
+  // method.md §9: --out is optional; without it the tables are printed and nothing is written.
+  const bool write = !FLAGS_out.empty();
   Drive drive;
   Status status = OpenDriveFromFlags(&drive);
   if (!status.ok()) return ReportError(kCommand, status);
@@ -103,8 +104,13 @@ int RunEvalTemporal() {
   status = ReadGroundTruth(drive, &simulated, &truth);
   if (!status.ok()) return ReportError(kCommand, status);
   if (simulated) options.drive_time_offset_s = truth.time_offset_s;
-  std::error_code ec;
-  std::filesystem::create_directories(FLAGS_out, ec);
+  if (write) {
+    std::error_code ec;
+    std::filesystem::create_directories(FLAGS_out, ec);
+    if (ec || !std::filesystem::is_directory(FLAGS_out)) {
+      return ReportError(kCommand, Status::Error(FLAGS_out + ": cannot create output folder"));
+    }
+  }
   std::string md = "# Temporal evaluation (method.md §8)\n\nDrive " + drive.drive_dir +
                    ", LiDAR decimated by " + std::to_string(options.lidar_decimation) + " and " +
                    std::to_string(options.lidar_delay_s) + " s late.\n\n";
@@ -116,13 +122,14 @@ int RunEvalTemporal() {
                  remove_dynamic ? "with" : "without");
     status = EvaluateTemporal(drive, options, &r);
     if (!status.ok()) return ReportError(kCommand, status);
-    const std::string name = remove_dynamic ? "table_dynamic_removed" : "table";
-    status = WriteTextFile(FLAGS_out + "/" + name + ".csv", TableCsv(r));
-    if (!status.ok()) return ReportError(kCommand, status);
     const std::string section =
         TableMarkdown(remove_dynamic ? "With dynamic points removed" : "All points", r);
     md += section + "\n";
     std::printf("%s\n", section.c_str());
+    if (!write) continue;
+    const std::string name = remove_dynamic ? "table_dynamic_removed" : "table";
+    status = WriteTextFile(FLAGS_out + "/" + name + ".csv", TableCsv(r));
+    if (!status.ok()) return ReportError(kCommand, status);
     status =
         WriteImage(FLAGS_out + "/" + (remove_dynamic ? "curves_dynamic_removed.png" : "curves.png"),
                    Curves(r));
@@ -132,6 +139,8 @@ int RunEvalTemporal() {
   std::snprintf(line, sizeof(line), "Motion model time offset: %.4f s (drive %.4f s − delay).\n",
                 all.time_offset_s, options.drive_time_offset_s);
   md += line;
+  std::printf("%s", line);
+  if (!write) return kExitOk;
   status = WriteTextFile(FLAGS_out + "/table.md", md);
   if (!status.ok()) return ReportError(kCommand, status);
   std::printf(

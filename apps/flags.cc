@@ -9,7 +9,9 @@ DEFINE_string(calib_dir, "",
               "folder with calib_cam_to_cam.txt, calib_velo_to_cam.txt, calib_imu_to_velo.txt "
               "(default: the drive's parent folder)");
 DEFINE_int32(frame, 0, "frame index (0-based, in file-name order)");
-DEFINE_string(out, "", "output file or folder");
+DEFINE_string(out, "",
+              "output file or folder (calibrate, eval-temporal: optional; without it nothing "
+              "is written and the result is printed)");
 DEFINE_int32(frames, 40, "simulate: number of frames");
 DEFINE_uint64(seed, 1, "random seed (simulate: the whole drive)");
 DEFINE_double(time_offset_s, 0.0,

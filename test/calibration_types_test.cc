@@ -31,6 +31,38 @@ TEST(CalibrationError, PerturbationIsRecoveredPerAxis) {
   }
 }
 
+TEST(MountRollPitchYaw, RecoversTheAnglesAndIsWellConditioned) {
+  Eigen::Matrix3d R_forward;
+  R_forward << 0, -1, 0, 0, 0, -1, 1, 0, 0;  // LiDAR x forward, y left, z up -> camera z, -x, -y
+  EXPECT_LT(MountRollPitchYawDeg(R_forward).norm(), 1e-12);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> angle(-60.0, 60.0);
+  auto rotation = [](const Eigen::Vector3d& rpy_deg) {
+    const Eigen::Vector3d r = rpy_deg * M_PI / 180.0;
+    return (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) *
+            Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
+            Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))
+        .toRotationMatrix();
+  };
+  for (int trial = 0; trial < 50; ++trial) {
+    const Eigen::Vector3d rpy_deg(angle(rng), angle(rng), angle(rng));
+    EXPECT_LT((MountRollPitchYawDeg(R_forward * rotation(rpy_deg)) - rpy_deg).norm(), 1e-9);
+  }
+  // A mount a degree or two off the nominal one: a small rotation about a LiDAR axis moves the
+  // matching angle by about as much and the others hardly (Euler angles of R_camera_lidar itself
+  // swing by tens of degrees there, at gimbal lock).
+  const Eigen::Matrix3d R = R_forward * rotation(Eigen::Vector3d(0.8, -1.5, 1.2));
+  for (int axis = 0; axis < 3; ++axis) {
+    const Eigen::Vector3d step = 0.1 * Eigen::Vector3d::Unit(axis);
+    const Eigen::Vector3d moved =
+        MountRollPitchYawDeg(PerturbTcameraLidar(MakeRigid(R, Eigen::Vector3d::Zero()), step,
+                                                 Eigen::Vector3d::Zero())
+                                 .linear()) -
+        MountRollPitchYawDeg(R);
+    EXPECT_LT((moved - step).norm(), 0.01) << "axis " << axis << ": " << moved.transpose();
+  }
+}
+
 TEST(CalibrationError, RotationErrorOfKnownAngle) {
   const Eigen::Matrix3d a = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Matrix3d b = Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();

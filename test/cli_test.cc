@@ -161,7 +161,10 @@ TEST(Cli, CalibrateWithoutFeaturesFailsAndClaimsNothing) {
   text << result.rdbuf();
   EXPECT_THAT(text.str(), HasSubstr("\"converged\": false"));
   EXPECT_EQ(RunStcalib("calibrate --drive=" + drive + " --out=" + out + " --loss=l3").exit_code, 2);
-  EXPECT_EQ(RunStcalib("calibrate --drive=" + drive).exit_code, 2);  // no --out
+  // Without --out (optional, method.md §9) the verdict and exit code are the same.
+  const RunResult no_out = RunStcalib("calibrate --drive=" + drive);
+  EXPECT_EQ(no_out.exit_code, 1) << no_out.output;
+  EXPECT_THAT(no_out.output, HasSubstr("not converged"));
   EXPECT_EQ(
       RunStcalib("calibrate --drive=" + drive + " --out=" + out + " --num_frames=50").exit_code, 1);
 }
@@ -221,7 +224,7 @@ RunResult CalibrateFromTwoDegrees(const std::string& drive, const std::string& o
   return RunStcalib(
       "calibrate --flagfile=" STCALIB_SOURCE_DIR "/configs/sim.flags --drive=" + drive +
       " --perturb_rot_deg=2 --perturb_trans_m=0.05 --seed=" + std::to_string(seed) +
-      " --out=" + out + extra_flags);
+      (out.empty() ? std::string() : " --out=" + out) + extra_flags);
 }
 
 // Replaces line `index` (0-based) of a text file; `text` empty removes it.
@@ -344,6 +347,42 @@ TEST(Cli, CalibratesADriveWithoutOxtsFromScanRegistration) {
   // The same drive gives the same estimate either way.
   EXPECT_EQ(result["T_camera_lidar"], result_without_calib["T_camera_lidar"]);
   EXPECT_EQ(result["time_offset_s"], result_without_calib["time_offset_s"]);
+
+  // Without --out (optional, method.md §9): the same estimate, printed in the format of
+  // calib_velo_to_cam.txt and time_offset_s, and nothing written.
+  const auto entries = [&]() {
+    int n = 0;
+    for ([[maybe_unused]] const auto& e : std::filesystem::recursive_directory_iterator(tmp.path()))
+      ++n;
+    return n;
+  };
+  const int before = entries();
+  const RunResult printed = CalibrateFromTwoDegrees(drive, "", 3, kShortDrive);
+  EXPECT_EQ(printed.exit_code, 0) << printed.output;
+  EXPECT_EQ(entries(), before);
+  std::istringstream lines(printed.output);
+  std::vector<double> R, T;
+  double time_offset_s = std::nan("");
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream values(line.substr(line.find(':') + 1));
+    std::vector<double>* target = line.rfind("R: ", 0) == 0   ? &R
+                                  : line.rfind("T: ", 0) == 0 ? &T
+                                                              : nullptr;
+    if (target) {
+      for (double v; values >> v;) target->push_back(v);
+    } else if (line.rfind("time_offset_s: ", 0) == 0) {
+      values >> time_offset_s;
+    }
+  }
+  ASSERT_EQ(R.size(), 9u) << printed.output;
+  ASSERT_EQ(T.size(), 3u) << printed.output;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) {
+      EXPECT_NEAR(R[3 * row + col], result["T_camera_lidar"][4 * row + col].get<double>(), 1e-9);
+    }
+    EXPECT_NEAR(T[row], result["T_camera_lidar"][4 * row + 3].get<double>(), 1e-9);
+  }
+  EXPECT_NEAR(time_offset_s, result["time_offset_s"].get<double>(), 1e-9);
 }
 
 // The paper's disturbance protocol at the very end of a drive: the 3.5° disturbance two frames
@@ -440,7 +479,10 @@ TEST(Cli, EvalTemporalBadInput) {
       RunStcalib("eval-temporal --drive=" + drive + " --out=" + tmp.path() + "/e");
   EXPECT_EQ(short_drive.exit_code, 1);
   EXPECT_THAT(short_drive.output, HasSubstr("too few for a decimation of 2"));
-  EXPECT_EQ(RunStcalib("eval-temporal --drive=" + drive).exit_code, 2);
+  // Without --out (optional, method.md §9) the same error.
+  const RunResult no_out = RunStcalib("eval-temporal --drive=" + drive);
+  EXPECT_EQ(no_out.exit_code, 1) << no_out.output;
+  EXPECT_THAT(no_out.output, HasSubstr("too few for a decimation of 2"));
   EXPECT_EQ(RunStcalib("eval-temporal --drive=" + drive + " --out=" + tmp.path() +
                        "/e --lidar_decimation=0")
                 .exit_code,

@@ -33,7 +33,7 @@ Status ReadRigid(const std::string& path, Rigid3d* T) {
   return Status::Ok();
 }
 
-Status WriteRigid(const std::string& path, const Rigid3d& T, bool with_deltas) {
+KittiCalibFile RigidFile(const Rigid3d& T, bool with_deltas) {
   KittiCalibFile file;
   file.SetText("calib_time", "written by stcalib");
   file.SetMatrix("R", T.linear());
@@ -42,7 +42,7 @@ Status WriteRigid(const std::string& path, const Rigid3d& T, bool with_deltas) {
     file.SetNumbers("delta_f", {0.0, 0.0});
     file.SetNumbers("delta_c", {0.0, 0.0});
   }
-  return file.Write(path);
+  return file;
 }
 
 }  // namespace
@@ -84,6 +84,10 @@ Status KittiCalibFile::Read(const std::string& path, KittiCalibFile* file) {
 }
 
 Status KittiCalibFile::Write(const std::string& path) const {
+  return WriteTextFile(path, ToString());
+}
+
+std::string KittiCalibFile::ToString() const {
   std::string contents;
   for (const std::string& key : order_) {
     contents += key + ":";
@@ -95,7 +99,7 @@ Status KittiCalibFile::Write(const std::string& path) const {
     }
     contents += "\n";
   }
-  return WriteTextFile(path, contents);
+  return contents;
 }
 
 Status KittiCalibFile::GetMatrix(const std::string& key, int rows, int cols,
@@ -186,8 +190,12 @@ Status ReadVeloToCam(const std::string& path, Rigid3d* T_camera_lidar) {
   return ReadRigid(path, T_camera_lidar);
 }
 
+std::string VeloToCamText(const Rigid3d& T_camera_lidar) {
+  return RigidFile(T_camera_lidar, /*with_deltas=*/true).ToString();
+}
+
 Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar) {
-  return WriteRigid(path, T_camera_lidar, /*with_deltas=*/true);
+  return RigidFile(T_camera_lidar, /*with_deltas=*/true).Write(path);
 }
 
 Status ReadImuToVelo(const std::string& path, Rigid3d* T_lidar_imu) {
@@ -195,7 +203,7 @@ Status ReadImuToVelo(const std::string& path, Rigid3d* T_lidar_imu) {
 }
 
 Status WriteImuToVelo(const std::string& path, const Rigid3d& T_lidar_imu) {
-  return WriteRigid(path, T_lidar_imu, /*with_deltas=*/false);
+  return RigidFile(T_lidar_imu, /*with_deltas=*/false).Write(path);
 }
 
 }  // namespace stcalib

@@ -17,6 +17,7 @@ class KittiCalibFile {
  public:
   static Status Read(const std::string& path, KittiCalibFile* file);
   Status Write(const std::string& path) const;
+  std::string ToString() const;  ///< the text Write writes
 
   bool Has(const std::string& key) const { return numbers_.count(key) > 0; }
   // Fetches a numeric key holding exactly rows*cols numbers (row-major); errors name the file,
@@ -57,6 +58,7 @@ Status ReadCamToCam(const std::string& path, CameraCalibration* calibration);
 Status ReadVeloToCam(const std::string& path, Rigid3d* T_camera_lidar);
 // Writes R, T (and KITTI's delta_f / delta_c, zero) with 12 significant digits.
 Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar);
+std::string VeloToCamText(const Rigid3d& T_camera_lidar);  ///< what WriteVeloToCam writes
 
 // calib_imu_to_velo.txt: R (9) and T (3) of T_lidar_imu.
 Status ReadImuToVelo(const std::string& path, Rigid3d* T_lidar_imu);

@@ -1,5 +1,6 @@
 #include "core/types/calibration.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -35,6 +36,18 @@ Rigid3d PerturbTcameraLidar(const Rigid3d& T_camera_lidar, const Eigen::Vector3d
   T.linear() = T_camera_lidar.linear() * ExpSO3(rpy_lidar_deg / kRadToDeg);
   T.translation() += translation_offset_m;
   return T;
+}
+
+Eigen::Vector3d MountRollPitchYawDeg(const Eigen::Matrix3d& R_camera_lidar) {
+  Eigen::Matrix3d R_forward;
+  R_forward << 0, -1, 0,  //
+      0, 0, -1,           //
+      1, 0, 0;
+  const Eigen::Matrix3d R = R_forward.transpose() * R_camera_lidar;
+  const double roll = std::atan2(R(2, 1), R(2, 2));
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  return Eigen::Vector3d(roll, pitch, yaw) * kRadToDeg;
 }
 
 std::string ToString(const CalibrationError& error) {
