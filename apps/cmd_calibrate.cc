@@ -317,9 +317,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   if (outcome->converged) {
     status = WriteVeloToCam(out + "/calib_velo_to_cam.txt", outcome->estimate.T_camera_lidar);
     if (!status.ok()) return fail(status);
-    char line[64];
-    std::snprintf(line, sizeof(line), "%.9f\n", outcome->estimate.time_offset_s);
-    status = WriteTextFile(out + "/time_offset.txt", line);
+    status = WriteTimeOffset(out + "/time_offset.txt", outcome->estimate.time_offset_s);
     if (!status.ok()) return fail(status);
   } else {
     // Never leave a file that claims success.

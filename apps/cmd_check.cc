@@ -6,6 +6,7 @@
 
 #include "apps/commands.h"
 #include "apps/flags.h"
+#include "core/io/kitti_calib.h"
 #include "core/io/text.h"
 #include "core/online/frame_source.h"
 #include "core/online/health_check.h"
@@ -29,7 +30,19 @@ int RunCheck() {
   status = StartingCalibration(drive, FLAGS_init_calib, FLAGS_perturb_rot_deg,
                                FLAGS_perturb_trans_m, &rng, &calibration.T_camera_lidar);
   if (!status.ok()) return ReportError(kCommand, status);
-  calibration.time_offset_s = FLAGS_perturb_time_s;
+  // δ: stcalib's time_offset.txt beside the checked calib_velo_to_cam.txt when there is one
+  // (what `calibrate --out` writes), plus --perturb_time_s.
+  const std::string calib_path =
+      FLAGS_init_calib.empty() ? drive.calib_dir + "/calib_velo_to_cam.txt" : FLAGS_init_calib;
+  const std::string time_offset_path =
+      (std::filesystem::path(calib_path).parent_path() / "time_offset.txt").string();
+  std::string time_offset_source = "none stored, 0";
+  if (std::filesystem::exists(time_offset_path)) {
+    status = ReadTimeOffset(time_offset_path, &calibration.time_offset_s);
+    if (!status.ok()) return ReportError(kCommand, status);
+    time_offset_source = time_offset_path;
+  }
+  calibration.time_offset_s += FLAGS_perturb_time_s;
 
   const int count = static_cast<int>(drive.NumFrames());
   const int first = FLAGS_first_frame;
@@ -62,10 +75,9 @@ int RunCheck() {
   }
   const HealthCheckResult result = CheckCalibrationHealth(frames, calibration, options);
 
-  std::printf("calibration checked: %s%s\n",
-              FLAGS_init_calib.empty() ? (drive.calib_dir + "/calib_velo_to_cam.txt").c_str()
-                                       : FLAGS_init_calib.c_str(),
-              FLAGS_perturb_rot_deg != 0 || FLAGS_perturb_trans_m != 0 ? " (perturbed)" : "");
+  std::printf("calibration checked: %s%s; time offset %+.4f s (%s)\n", calib_path.c_str(),
+              FLAGS_perturb_rot_deg != 0 || FLAGS_perturb_trans_m != 0 ? " (perturbed)" : "",
+              calibration.time_offset_s, time_offset_source.c_str());
   std::printf(
       "health = share of the 728 neighbours at +-%.1f deg / +-%.2f m scoring worse; best "
       "neighbour = the largest score gain among them\n",
@@ -93,7 +105,9 @@ int RunCheck() {
   if (!FLAGS_out.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(FLAGS_out, ec);
-    const nlohmann::json j = {{"decided", result.decided},
+    const nlohmann::json j = {{"calibration", calib_path},
+                              {"time_offset_s", calibration.time_offset_s},
+                              {"decided", result.decided},
                               {"holds", result.holds},
                               {"mean_health", result.mean_health},
                               {"min_window_health", result.min_window_health},

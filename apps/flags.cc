@@ -31,7 +31,10 @@ DEFINE_string(init_calib, "", "calibrate: initial calib_velo_to_cam.txt (default
 DEFINE_double(perturb_rot_deg, 0.0,
               "calibrate: add this roll/pitch/yaw error (random signs) [deg]");
 DEFINE_double(perturb_trans_m, 0.0, "calibrate: add this x/y/z error (random signs) [m]");
-DEFINE_double(perturb_time_s, 0.0, "calibrate: initial time offset δ0 [s]");
+DEFINE_double(
+    perturb_time_s, 0.0,
+    "calibrate: initial time offset δ0 [s]; check: added to the stored δ (time_offset.txt "
+    "beside the checked calib_velo_to_cam.txt, else 0)");
 DEFINE_int32(first_frame, 0, "calibrate: first frame used");
 DEFINE_int32(num_frames, 0, "calibrate: frames used (0 = to the end)");
 // Defaults of the tuning flags come from the library's option structs, where the reasons for

@@ -195,6 +195,29 @@ TEST(Cli, CheckHoldsForKittiCalibrationAndCatchesOneDegreeOff) {
       RunStcalib("check --drive=" + testing::KittiDriveDir() + " --perturb_rot_deg=0.58 --seed=3");
   EXPECT_EQ(off.exit_code, 1) << off.output;
   EXPECT_THAT(off.output, HasSubstr("the calibration is off"));
+  // A stored calibration as `calibrate --out` leaves it: δ comes from the time_offset.txt beside
+  // calib_velo_to_cam.txt. A quarter of a second off moves the scene by metres; a malformed file
+  // is named.
+  const std::string stored = tmp.path() + "/stored";
+  std::filesystem::create_directories(stored);
+  std::filesystem::copy_file(
+      std::filesystem::path(testing::KittiDriveDir()).parent_path() / "calib_velo_to_cam.txt",
+      stored + "/calib_velo_to_cam.txt");
+  const std::string check_stored = "check --drive=" + testing::KittiDriveDir() +
+                                   " --init_calib=" + stored + "/calib_velo_to_cam.txt";
+  testing::WriteFile(stored + "/time_offset.txt", "0.25\n");
+  const RunResult late = RunStcalib(check_stored + " --out=" + tmp.path() + "/late");
+  EXPECT_EQ(late.exit_code, 1) << late.output;
+  EXPECT_THAT(late.output, HasSubstr("time offset +0.2500 s (" + stored + "/time_offset.txt)"));
+  EXPECT_THAT(late.output, HasSubstr("the calibration is off"));
+  EXPECT_EQ(nlohmann::json::parse(testing::ReadFile(tmp.path() + "/late/check.json"))
+                ["time_offset_s"]
+                    .get<double>(),
+            0.25);
+  testing::WriteFile(stored + "/time_offset.txt", "0.01 0.02\n");
+  const RunResult two = RunStcalib(check_stored);
+  EXPECT_EQ(two.exit_code, 1) << two.output;
+  EXPECT_THAT(two.output, HasSubstr(stored + "/time_offset.txt: expected one number"));
   EXPECT_EQ(RunStcalib("check").exit_code, 2);
   EXPECT_EQ(RunStcalib("check --drive=" + tmp.path() + "/absent").exit_code, 1);
 }

@@ -165,6 +165,33 @@ TEST(KittiWriters, VeloToCamRoundTripIsExactToPrintedPrecision) {
   EXPECT_LT((read.matrix() - T.matrix()).cwiseAbs().maxCoeff(), 1e-12);
   ASSERT_TRUE(WriteVeloToCam(b, read).ok());
   EXPECT_EQ(testing::ReadFile(a), testing::ReadFile(b));
+  // The printed estimate (calibrate without --out) is the file's text.
+  EXPECT_EQ(VeloToCamText(T), testing::ReadFile(a));
+}
+
+TEST(KittiWriters, TimeOffsetRoundTripAndBadFilesAreNamed) {
+  testing::ScopedTempDir tmp;
+  const std::string path = tmp.path() + "/time_offset.txt";
+  ASSERT_TRUE(WriteTimeOffset(path, -0.0123456789).ok());
+  EXPECT_EQ(testing::ReadFile(path), "-0.012345679\n");
+  double read = 0;
+  ASSERT_TRUE(ReadTimeOffset(path, &read).ok());
+  EXPECT_EQ(read, -0.012345679);
+  testing::WriteFile(path, "\n  0.03 \n\n");  // blank lines and spaces are fine
+  ASSERT_TRUE(ReadTimeOffset(path, &read).ok());
+  EXPECT_EQ(read, 0.03);
+  for (const auto& [text, message] :
+       std::vector<std::pair<std::string, std::string>>{{"", "expected one number"},
+                                                        {"0.1 0.2\n", "found 2"},
+                                                        {"nan\n", "'nan' is not a finite number"},
+                                                        {"30ms\n", "'30ms' is not a finite"}}) {
+    testing::WriteFile(path, text);
+    const Status status = ReadTimeOffset(path, &read);
+    EXPECT_FALSE(status.ok()) << text;
+    EXPECT_THAT(status.message(), ::testing::HasSubstr(path + ": ")) << text;
+    EXPECT_THAT(status.message(), ::testing::HasSubstr(message)) << status.message();
+  }
+  EXPECT_FALSE(ReadTimeOffset(tmp.path() + "/absent.txt", &read).ok());
 }
 
 TEST(KittiWriters, CamToCamRewritesEveryKey) {

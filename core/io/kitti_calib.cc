@@ -198,6 +198,30 @@ Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar) {
   return RigidFile(T_camera_lidar, /*with_deltas=*/true).Write(path);
 }
 
+Status ReadTimeOffset(const std::string& path, double* time_offset_s) {
+  std::vector<std::string> lines;
+  STCALIB_RETURN_IF_ERROR(ReadLines(path, &lines));
+  std::string text;
+  for (const std::string& line : lines) text += line + " ";
+  std::vector<double> values;
+  std::string bad;
+  if (!ParseNumbers(text, &values, &bad)) {
+    return Status::Error(path + ": '" + bad + "' is not a finite number");
+  }
+  if (values.size() != 1) {
+    return Status::Error(path + ": expected one number (the time offset in seconds), found " +
+                         std::to_string(values.size()));
+  }
+  *time_offset_s = values[0];
+  return Status::Ok();
+}
+
+Status WriteTimeOffset(const std::string& path, double time_offset_s) {
+  char line[64];
+  std::snprintf(line, sizeof(line), "%.9f\n", time_offset_s);
+  return WriteTextFile(path, line);
+}
+
 Status ReadImuToVelo(const std::string& path, Rigid3d* T_lidar_imu) {
   return ReadRigid(path, T_lidar_imu);
 }

@@ -60,6 +60,11 @@ Status ReadVeloToCam(const std::string& path, Rigid3d* T_camera_lidar);
 Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar);
 std::string VeloToCamText(const Rigid3d& T_camera_lidar);  ///< what WriteVeloToCam writes
 
+// time_offset.txt (stcalib's, beside its calib_velo_to_cam.txt): δ in seconds, one finite
+// number; blank lines are ignored. Errors name the file and what is wrong.
+Status ReadTimeOffset(const std::string& path, double* time_offset_s);
+Status WriteTimeOffset(const std::string& path, double time_offset_s);  ///< 9 decimals
+
 // calib_imu_to_velo.txt: R (9) and T (3) of T_lidar_imu.
 Status ReadImuToVelo(const std::string& path, Rigid3d* T_lidar_imu);
 Status WriteImuToVelo(const std::string& path, const Rigid3d& T_lidar_imu);
