@@ -36,13 +36,14 @@ int RunCheck() {
       FLAGS_init_calib.empty() ? drive.calib_dir + "/calib_velo_to_cam.txt" : FLAGS_init_calib;
   const std::string time_offset_path =
       (std::filesystem::path(calib_path).parent_path() / "time_offset.txt").string();
-  std::string time_offset_source = "none stored, 0";
-  if (std::filesystem::exists(time_offset_path)) {
-    status = ReadTimeOffset(time_offset_path, &calibration.time_offset_s);
+  double stored_time_offset_s = 0;
+  std::error_code ec;
+  const bool has_time_offset = std::filesystem::exists(time_offset_path, ec);
+  if (has_time_offset) {
+    status = ReadTimeOffset(time_offset_path, &stored_time_offset_s);
     if (!status.ok()) return ReportError(kCommand, status);
-    time_offset_source = time_offset_path;
   }
-  calibration.time_offset_s += FLAGS_perturb_time_s;
+  calibration.time_offset_s = stored_time_offset_s + FLAGS_perturb_time_s;
 
   const int count = static_cast<int>(drive.NumFrames());
   const int first = FLAGS_first_frame;
@@ -75,9 +76,11 @@ int RunCheck() {
   }
   const HealthCheckResult result = CheckCalibrationHealth(frames, calibration, options);
 
-  std::printf("calibration checked: %s%s; time offset %+.4f s (%s)\n", calib_path.c_str(),
+  std::printf("calibration checked: %s%s; time offset %+.4f s (%s%+.4f s%s)\n", calib_path.c_str(),
               FLAGS_perturb_rot_deg != 0 || FLAGS_perturb_trans_m != 0 ? " (perturbed)" : "",
-              calibration.time_offset_s, time_offset_source.c_str());
+              calibration.time_offset_s,
+              has_time_offset ? (time_offset_path + ": ").c_str() : "none stored: ",
+              stored_time_offset_s, FLAGS_perturb_time_s != 0 ? ", plus --perturb_time_s" : "");
   std::printf(
       "health = share of the 728 neighbours at +-%.1f deg / +-%.2f m scoring worse; best "
       "neighbour = the largest score gain among them\n",

@@ -40,20 +40,23 @@ const std::vector<Subcommand>& Subcommands() {
        "--drive=DRIVE_DIR [--calib_dir=DIR] [--init_calib=FILE] [--perturb_rot_deg=D] "
        "[--perturb_trans_m=M] [--perturb_time_s=S] [--seed=S] [--first_frame=I] [--num_frames=N] "
        "[--out=DIR] [--flagfile=configs/X.flags]",
-       "online calibration of rotation, translation and time offset; writes the estimate, "
-       "result.json, per_frame.csv and pictures; exit 0 only when converged",
+       "online calibration of rotation, translation and time offset; with --out writes the "
+       "estimate, result.json, per_frame.csv and pictures, without it prints the estimate; exit 0 "
+       "only when converged",
        &RunCalibrate},
       {"eval-temporal",
        "--drive=DRIVE_DIR [--lidar_decimation=2] [--lidar_delay_s=0.1] [--out=DIR]",
        "the paper's Table I: ApproximateTime pairing vs the motion model (filter_cloud, "
-       "infer_cloud, infer_cloud_interpolation)",
+       "infer_cloud, infer_cloud_interpolation); prints the tables, --out also writes them",
        &RunEvalTemporal},
       {"check",
        "--drive=DRIVE_DIR [--calib_dir=DIR] [--init_calib=FILE] [--perturb_rot_deg=D] "
-       "[--perturb_trans_m=M] [--perturb_time_s=S (its time offset)] [--seed=S] [--first_frame=I] "
+       "[--perturb_trans_m=M] [--perturb_time_s=S (added to the stored δ)] [--seed=S] "
+       "[--first_frame=I] "
        "[--num_frames=N] [--out=DIR] "
        "[--min_health=H]",
-       "health score of the stored calibration per window of frames; exit 0 when it holds, 1 "
+       "health score of the stored calibration (δ from time_offset.txt beside it) per window of "
+       "frames; exit 0 when it holds, 1 "
        "when it is off, with the evidence",
        &RunCheck},
       {"demo", "[--out=DIR] [--seed=S]",

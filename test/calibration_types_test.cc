@@ -10,10 +10,8 @@ namespace {
 TEST(CalibrationError, PerturbationIsRecoveredPerAxis) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> angle(-3.0, 3.0), offset(-0.1, 0.1);
-  Eigen::Matrix3d R;
-  R << 0, -1, 0, 0, 0, -1, 1, 0, 0;
   CalibrationState reference;
-  reference.T_camera_lidar = MakeRigid(R, Eigen::Vector3d(0.0, -0.08, -0.27));
+  reference.T_camera_lidar = MakeRigid(NominalRcameraLidar(), Eigen::Vector3d(0.0, -0.08, -0.27));
   reference.time_offset_s = 0.01;
   for (int trial = 0; trial < 50; ++trial) {
     const Eigen::Vector3d rpy_deg(angle(rng), angle(rng), angle(rng));
@@ -32,8 +30,12 @@ TEST(CalibrationError, PerturbationIsRecoveredPerAxis) {
 }
 
 TEST(MountRollPitchYaw, RecoversTheAnglesAndIsWellConditioned) {
-  Eigen::Matrix3d R_forward;
-  R_forward << 0, -1, 0, 0, 0, -1, 1, 0, 0;  // LiDAR x forward, y left, z up -> camera z, -x, -y
+  // The nominal mount: the LiDAR's forward axis is the camera's optical axis, its up the image's
+  // up (camera −y).
+  const Eigen::Matrix3d R_forward = NominalRcameraLidar();
+  EXPECT_EQ(R_forward * Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(R_forward * Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitY());
+  EXPECT_EQ(R_forward * Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitX());
   EXPECT_LT(MountRollPitchYawDeg(R_forward).norm(), 1e-12);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> angle(-60.0, 60.0);

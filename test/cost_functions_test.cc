@@ -237,8 +237,7 @@ TEST(EdgeAlignmentCost, JacobiansMatchNumericDifferentiation) {
   const ceres::LossFunction* losses[2] = {&cauchy, &huber};
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> unit(-1, 1);
-  Eigen::Matrix3d R0;
-  R0 << 0, -1, 0, 0, 0, -1, 1, 0, 0;  // LiDAR x forward → camera z
+  const Eigen::Matrix3d R0 = NominalRcameraLidar();  // LiDAR x forward → camera z
   int checked = 0;
   for (int trial = 0; trial < 60; ++trial) {
     const LidarTwist twist = RandomTwist(&rng);

@@ -184,7 +184,8 @@ TEST(KittiWriters, TimeOffsetRoundTripAndBadFilesAreNamed) {
        std::vector<std::pair<std::string, std::string>>{{"", "expected one number"},
                                                         {"0.1 0.2\n", "found 2"},
                                                         {"nan\n", "'nan' is not a finite number"},
-                                                        {"30ms\n", "'30ms' is not a finite"}}) {
+                                                        {"30ms\n", "'30ms' is not a finite"},
+                                                        {"1.5\n", "beyond ±1 s"}}) {
     testing::WriteFile(path, text);
     const Status status = ReadTimeOffset(path, &read);
     EXPECT_FALSE(status.ok()) << text;

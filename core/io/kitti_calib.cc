@@ -1,5 +1,6 @@
 #include "core/io/kitti_calib.h"
 
+#include <cmath>
 #include <cstdio>
 
 #include "core/io/text.h"
@@ -206,11 +207,15 @@ Status ReadTimeOffset(const std::string& path, double* time_offset_s) {
   std::vector<double> values;
   std::string bad;
   if (!ParseNumbers(text, &values, &bad)) {
-    return Status::Error(path + ": '" + bad + "' is not a finite number");
+    return Status::Error(path + ": '" + bad + "' is not a finite number of seconds");
   }
   if (values.size() != 1) {
     return Status::Error(path + ": expected one number (the time offset in seconds), found " +
                          std::to_string(values.size()));
+  }
+  if (std::abs(values[0]) > 1.0) {
+    return Status::Error(path + ": time offset " + std::to_string(values[0]) +
+                         " s is beyond ±1 s (a whole second between two sensors of one rig)");
   }
   *time_offset_s = values[0];
   return Status::Ok();

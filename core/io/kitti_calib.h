@@ -61,7 +61,7 @@ Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar);
 std::string VeloToCamText(const Rigid3d& T_camera_lidar);  ///< what WriteVeloToCam writes
 
 // time_offset.txt (stcalib's, beside its calib_velo_to_cam.txt): δ in seconds, one finite
-// number; blank lines are ignored. Errors name the file and what is wrong.
+// number within ±1 s; blank lines are ignored. Errors name the file and what is wrong.
 Status ReadTimeOffset(const std::string& path, double* time_offset_s);
 Status WriteTimeOffset(const std::string& path, double time_offset_s);  ///< 9 decimals
 

@@ -38,12 +38,17 @@ Rigid3d PerturbTcameraLidar(const Rigid3d& T_camera_lidar, const Eigen::Vector3d
   return T;
 }
 
-Eigen::Vector3d MountRollPitchYawDeg(const Eigen::Matrix3d& R_camera_lidar) {
-  Eigen::Matrix3d R_forward;
-  R_forward << 0, -1, 0,  //
-      0, 0, -1,           //
+Eigen::Matrix3d NominalRcameraLidar() {
+  Eigen::Matrix3d R;
+  R << 0, -1, 0,  //
+      0, 0, -1,   //
       1, 0, 0;
-  const Eigen::Matrix3d R = R_forward.transpose() * R_camera_lidar;
+  return R;
+}
+
+Eigen::Vector3d MountRollPitchYawDeg(const Eigen::Matrix3d& R_camera_lidar) {
+  // R_nominal_lidar = Rz(yaw)·Ry(pitch)·Rx(roll): the LiDAR's axes in the nominal frame.
+  const Eigen::Matrix3d R = NominalRcameraLidar().transpose() * R_camera_lidar;
   const double roll = std::atan2(R(2, 1), R(2, 2));
   const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
   const double yaw = std::atan2(R(1, 0), R(0, 0));

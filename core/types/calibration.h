@@ -38,10 +38,13 @@ CalibrationError ComputeCalibrationError(const CalibrationState& estimate,
 Rigid3d PerturbTcameraLidar(const Rigid3d& T_camera_lidar, const Eigen::Vector3d& rpy_lidar_deg,
                             const Eigen::Vector3d& translation_offset_m);
 
+// The nominal mount of a forward-looking camera: the LiDAR's x forward, y left, z up become the
+// camera's z (forward), −x (x right), −y (y down).
+Eigen::Matrix3d NominalRcameraLidar();
+
 // The LiDAR's mount angles relative to the camera [deg], (roll, pitch, yaw) about the LiDAR's
-// axes (x forward, y left, z up): R_camera_lidar = R_forward · Rz(yaw) · Ry(pitch) · Rx(roll),
-// where R_forward is the nominal mount that takes the LiDAR's x forward, y left, z up to the
-// camera's z, −x, −y. For a forward-looking camera these are small, well-conditioned angles
+// axes (x forward, y left, z up): R_camera_lidar = NominalRcameraLidar() · Rz(yaw) · Ry(pitch) ·
+// Rx(roll). For a forward-looking camera these are small, well-conditioned angles
 // (Euler angles of R_camera_lidar itself sit at gimbal lock, pitch ≈ −90°).
 Eigen::Vector3d MountRollPitchYawDeg(const Eigen::Matrix3d& R_camera_lidar);
 
