@@ -275,6 +275,14 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   outcome->converged = verdict.converged;
   outcome->reason = verdict.reason;
   outcome->alias_suspect = verdict.time_offset_profile.alias_suspect;
+  auto verdict_code = [&]() {
+    if (outcome->converged) return kExitOk;
+    std::fprintf(stderr, "stcalib calibrate: %s\n", outcome->reason.c_str());
+    return kExitFailure;
+  };
+  // method.md §9: --out is optional; without it nothing is written (the caller prints the
+  // estimate) and none of the files' contents are made.
+  if (job.out_dir.empty()) return verdict_code();
   const TimeOffsetProfile& profile = verdict.time_offset_profile;
   nlohmann::json profiles_json;
   for (int axis = 0; axis < 3; ++axis) {
@@ -304,25 +312,18 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   // The covariance is the refinement the verdict read (the polish holds the translation).
   const RefineResult& refine = verdict.refine;
 
-  // Outputs (method.md §9: --out is optional; without it nothing is written and the caller
-  // prints the estimate).
+  // Outputs.
   const std::string out = job.out_dir;
   auto fail = [&](const Status& s) { return ReportError(kCommand, s); };
-  auto verdict_code = [&]() {
-    if (outcome->converged) return kExitOk;
-    std::fprintf(stderr, "stcalib calibrate: %s\n", outcome->reason.c_str());
-    return kExitFailure;
-  };
-  if (out.empty()) return verdict_code();
   if (outcome->converged) {
     status = WriteVeloToCam(out + "/calib_velo_to_cam.txt", outcome->estimate.T_camera_lidar);
     if (!status.ok()) return fail(status);
-    status = WriteTimeOffset(out + "/time_offset.txt", outcome->estimate.time_offset_s);
+    status = WriteTimeOffset(out + "/" + kTimeOffsetFileName, outcome->estimate.time_offset_s);
     if (!status.ok()) return fail(status);
   } else {
     // Never leave a file that claims success.
     fs::remove(out + "/calib_velo_to_cam.txt", ec);
-    fs::remove(out + "/time_offset.txt", ec);
+    fs::remove(out + "/" + kTimeOffsetFileName, ec);
   }
   nlohmann::json std_json, observable_json;
   for (int k = 0; k < kNumAxes; ++k) {

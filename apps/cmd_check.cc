@@ -35,7 +35,7 @@ int RunCheck() {
   const std::string calib_path =
       FLAGS_init_calib.empty() ? drive.calib_dir + "/calib_velo_to_cam.txt" : FLAGS_init_calib;
   const std::string time_offset_path =
-      (std::filesystem::path(calib_path).parent_path() / "time_offset.txt").string();
+      (std::filesystem::path(calib_path).parent_path() / kTimeOffsetFileName).string();
   double stored_time_offset_s = 0;
   std::error_code ec;
   const bool has_time_offset = std::filesystem::exists(time_offset_path, ec);

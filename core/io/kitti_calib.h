@@ -62,6 +62,7 @@ std::string VeloToCamText(const Rigid3d& T_camera_lidar);  ///< what WriteVeloTo
 
 // time_offset.txt (stcalib's, beside its calib_velo_to_cam.txt): δ in seconds, one finite
 // number within ±1 s; blank lines are ignored. Errors name the file and what is wrong.
+inline constexpr char kTimeOffsetFileName[] = "time_offset.txt";
 Status ReadTimeOffset(const std::string& path, double* time_offset_s);
 Status WriteTimeOffset(const std::string& path, double time_offset_s);  ///< 9 decimals
 
