@@ -172,8 +172,10 @@ void BM_LocalMapMergeOxts(benchmark::State& state) {
   const auto pose = Kitti().motion.PoseFunction();
   for (auto _ : state) {
     benchmark::DoNotOptimize(
-        MergeEdges(f10.edges, {{&f8.edges, RelativeLidarPose(pose, f10.stamp_s, f8.stamp_s)},
-                               {&f9.edges, RelativeLidarPose(pose, f10.stamp_s, f9.stamp_s)}}));
+        MergeEdges(f10.edges, {{&f8.edges, RelativeLidarPose(pose, f10.stamp_s, f8.stamp_s),
+                                RelativeLidarPoseRate(pose, f10.stamp_s, f8.stamp_s)},
+                               {&f9.edges, RelativeLidarPose(pose, f10.stamp_s, f9.stamp_s),
+                                RelativeLidarPoseRate(pose, f10.stamp_s, f9.stamp_s)}}));
   }
 }
 BENCHMARK(BM_LocalMapMergeOxts)->Unit(benchmark::kMillisecond);

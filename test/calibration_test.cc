@@ -1,6 +1,7 @@
 // Calibration on a simulated drive with exact truth: search, refinement, health, time-offset
 // profile and the online calibrator (issue 5). One drive is simulated once and every stage is
 // checked on it, so this stays a few seconds long.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -339,6 +340,25 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   EXPECT_TRUE(refine.covariance_ok);
   EXPECT_LT(std::abs(refine_error.time_offset_s), 0.02);
 
+  // The translation along the direction of travel only (the polish's first stage): it moves along
+  // the last frame's LiDAR velocity in the camera frame and nowhere else, and its covariance is
+  // of rank one along that direction.
+  RefineOptions along_options;
+  along_options.translation = RefineOptions::Translation::kAlongTravel;
+  const RefineResult along = Refine(long_window, near, near, truth, along_options);
+  ASSERT_TRUE(along.usable && along.covariance_ok) << along.message;
+  const Eigen::Vector3d forward =
+      (near.T_camera_lidar.linear() * long_window.back()->twist.linear_m_s).normalized();
+  const Eigen::Vector3d moved =
+      along.state.T_camera_lidar.translation() - near.T_camera_lidar.translation();
+  std::printf("refine along travel: moved %.2f cm, forward std %.2f cm, δ std %.2f ms, corr %.2f\n",
+              100 * moved.norm(), 100 * along.forward_std_m, 1000 * along.std_dev[6],
+              along.time_forward_correlation);
+  EXPECT_LT(moved.cross(forward).norm(), 1e-9);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(along.std_dev[3 + k], std::abs(forward[k]) * along.forward_std_m, 1e-9);
+  }
+
   // δ profile: the best offset is near the truth.
   const TimeOffsetProfile profile = ProfileTimeOffset(&scorer, truth, 0.15, 0.0025);
   std::printf("time-offset profile: best %.4f s (truth 0.03), second peak ratio %.2f\n",
@@ -502,9 +522,11 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
       RotationErrorDeg(calibrator.state().T_camera_lidar.linear(), settled.T_camera_lidar.linear()),
       0.4);
 
-  // Polish: a rotation-only refinement over the refinement's frames from the estimate. From two
-  // estimates 0.6° apart it lands on one optimum (the online estimate is a filtered one; the
-  // polish takes it to where the refinement puts it), holding the translation and δ exactly.
+  // Polish: a refinement over the refinement's frames from the estimate. On these ten frames the
+  // forward translation and δ cannot be told apart, so both are held and it is a rotation-only
+  // one. From two estimates 0.6° apart it lands on one optimum (the online estimate is a filtered
+  // one; the polish takes it to where the refinement puts it), holding the translation and δ
+  // exactly.
   const CalibrationState tracked = calibrator.state();
   std::vector<CalibrationState> polished;
   for (const Eigen::Vector3d& offset_deg :
@@ -513,6 +535,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     const CalibrationState before_polish = calibrator.state();
     const FrameReport polish = calibrator.Polish();
     ASSERT_TRUE(polish.accepted) << polish.reason;
+    EXPECT_THAT(polish.reason, ::testing::HasSubstr("forward translation and δ held"));
     EXPECT_TRUE(polish.refine.covariance_ok);  // rotation only: translation and δ held
     for (int k = 3; k < kNumAxes; ++k) EXPECT_FALSE(polish.refine.observable[k]) << kAxisNames[k];
     EXPECT_TRUE(polish.refine.observable[0] && polish.refine.observable[1] &&

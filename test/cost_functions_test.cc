@@ -1,6 +1,7 @@
 // Motion model Tv(δ), the edge-alignment residual and the prior: nominal values computed by hand
 // and Jacobians checked against numeric differentiation (ceres::GradientChecker).
 #include <ceres/manifold.h>
+#include <ceres/manifold_test_utils.h>
 #include <ceres/product_manifold.h>
 #include <gtest/gtest.h>
 
@@ -10,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "core/refine/along_direction_manifold.h"
 #include "core/types/calibration.h"
 #include "cost_functions/calibration_prior_cost.h"
 #include "cost_functions/edge_alignment_cost.h"
@@ -333,6 +335,32 @@ TEST(EdgeAlignmentCost, JacobiansMatchNumericDifferentiation) {
     }
   }
   EXPECT_GT(checked, 150);
+}
+
+// The translation that moves only along the direction of travel (the polish, RefineOptions::
+// Translation::kAlongTravel): Ceres' manifold invariants (Plus/Minus inverse on the line,
+// Jacobians against numeric differentiation), and Plus moves along d only.
+TEST(AlongDirectionManifold, InvariantsHoldAndPlusMovesAlongTheDirection) {
+  using namespace ceres;  // the invariant macro names its matchers unqualified
+  const Eigen::Vector3d d = Eigen::Vector3d(0.1, -0.05, 2.0);  // not unit: normalised inside
+  const AlongDirectionManifold manifold(d);
+  EXPECT_EQ(manifold.AmbientSize(), 3);
+  EXPECT_EQ(manifold.TangentSize(), 1);
+  EXPECT_NEAR(manifold.direction().norm(), 1.0, 1e-15);
+  Vector x(3), delta(1), y(3);
+  x << 0.06, -0.08, -0.27;
+  delta << 0.043;
+  y = x + 0.021 * d.normalized();
+  EXPECT_THAT_MANIFOLD_INVARIANTS_HOLD(manifold, x, delta, y, 1e-9);
+  Eigen::Vector3d moved;
+  ASSERT_TRUE(manifold.Plus(x.data(), delta.data(), moved.data()));
+  EXPECT_LT((moved - x).cross(d).norm(), 1e-15);
+  EXPECT_NEAR((moved - x).norm(), 0.043, 1e-15);
+  // Minus of a point off the line: the component along d.
+  const Eigen::Vector3d off = x + Eigen::Vector3d(0.3, 0.2, 0.1);
+  double along = 0;
+  ASSERT_TRUE(manifold.Minus(off.data(), x.data(), &along));
+  EXPECT_NEAR(along, d.normalized().dot(Eigen::Vector3d(0.3, 0.2, 0.1)), 1e-15);
 }
 
 TEST(CalibrationPriorCost, NominalValuesAndJacobians) {

@@ -59,6 +59,7 @@ LidarEdges KeepRuns(const LidarEdges &edges, const ScanRings &rings,
     kept.time_s.push_back(edges.time_s[k]);
     kept.kind.push_back(edges.kind[k]);
     kept.source_index.push_back(edges.source_index[k]);
+    kept.offset_rate.push_back(edges.offset_rate[k]);
   }
   return kept;
 }
@@ -81,6 +82,7 @@ void LidarEdges::Append(const LidarEdges &other) {
   time_s.insert(time_s.end(), other.time_s.begin(), other.time_s.end());
   kind.insert(kind.end(), other.kind.begin(), other.kind.end());
   source_index.insert(source_index.end(), other.source_index.begin(), other.source_index.end());
+  offset_rate.insert(offset_rate.end(), other.offset_rate.begin(), other.offset_rate.end());
 }
 
 LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
@@ -119,6 +121,7 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
     edges.time_s.push_back(point_time_s[i]);
     edges.kind.push_back(kind);
     edges.source_index.push_back(i);
+    edges.offset_rate.push_back(Eigen::Vector3d::Zero());
   };
 
   // Vertical edges: along each ring, returns in azimuth order.

@@ -49,6 +49,9 @@ struct LidarEdges {
   std::vector<double> time_s;  ///< capture time relative to the sweep stamp [s]
   std::vector<EdgeKind> kind;
   std::vector<int> source_index;  ///< index in the scan (−1 after merging into a local map)
+  // ∂p/∂δ [m/s]: how the point moves with the time offset δ beyond the motion model's Tv (a
+  // local map's earlier sweeps, RelativeLidarPoseRate); zero in a sweep's own edges.
+  std::vector<Eigen::Vector3d> offset_rate;
 
   size_t size() const { return points_lidar.size(); }
   bool empty() const { return points_lidar.empty(); }

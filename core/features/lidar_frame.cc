@@ -165,13 +165,16 @@ Status LoadLidarFrameFeatures(const Drive& drive, const DriveMotion& motion, siz
   return Status::Ok();
 }
 
-LidarEdges MergeEdges(const LidarEdges& current,
-                      const std::vector<std::pair<const LidarEdges*, Rigid3d>>& previous) {
+LidarEdges MergeEdges(const LidarEdges& current, const std::vector<SweepInMap>& previous) {
   LidarEdges map = current;
-  for (const auto& [edges, T_current_previous] : previous) {
-    LidarEdges moved = *edges;
+  for (const SweepInMap& sweep : previous) {
+    LidarEdges moved = *sweep.edges;
+    const Rigid3d& T = sweep.T_current_previous;
     for (size_t i = 0; i < moved.size(); ++i) {
-      moved.points_lidar[i] = T_current_previous * moved.points_lidar[i];
+      const Eigen::Vector3d& p = sweep.edges->points_lidar[i];
+      moved.offset_rate[i] = T.linear() * moved.offset_rate[i] +
+                             sweep.offset_rate.leftCols<3>() * p + sweep.offset_rate.col(3);
+      moved.points_lidar[i] = T * p;
       moved.source_index[i] = -1;
     }
     map.Append(moved);
@@ -210,7 +213,7 @@ Status SweepCache::LocalMap(size_t frame, const LocalMapOptions& map_options, Li
     sweeps.push_back(f);
   }
   sweeps.push_back(current_features);
-  std::vector<std::pair<const LidarEdges*, Rigid3d>> previous;
+  std::vector<SweepInMap> previous;
   for (size_t k = 0; k + 1 < sweeps.size(); ++k) {
     Rigid3d T = RelativeLidarPose(motion_.PoseFunction(), current.stamp_s, sweeps[k]->stamp_s);
     if (map_options.use_ndt) {
@@ -228,7 +231,10 @@ Status SweepCache::LocalMap(size_t frame, const LocalMapOptions& map_options, Li
           (result.T_target_source.translation() - T.translation()).norm());
       T = result.T_target_source;
     }
-    previous.emplace_back(&sweeps[k]->edges, T);
+    // The rate from the motion (NDT corrects the pose at the stamps, not its rate).
+    previous.push_back(
+        {&sweeps[k]->edges, T,
+         RelativeLidarPoseRate(motion_.PoseFunction(), current.stamp_s, sweeps[k]->stamp_s)});
   }
   *map = MergeEdges(current.edges, previous);
   stats->sweeps_used = static_cast<int>(sweeps.size());

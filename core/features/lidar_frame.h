@@ -103,8 +103,15 @@ Status BuildLocalMap(const Drive& drive, const DriveMotion& motion, size_t frame
                      const LidarFeatureOptions& options, const LocalMapOptions& map_options,
                      LidarEdges* map, LocalMapStats* stats);
 
-// Merges `previous` (each with its pose in the current frame) into `current`.
-LidarEdges MergeEdges(const LidarEdges& current,
-                      const std::vector<std::pair<const LidarEdges*, Rigid3d>>& previous);
+// An earlier sweep's edges and their pose in the current sweep's frame, with the pose's rate
+// under a common shift of both stamps (RelativeLidarPoseRate; zero: none).
+struct SweepInMap {
+  const LidarEdges* edges = nullptr;
+  Rigid3d T_current_previous = Rigid3d::Identity();
+  Eigen::Matrix<double, 3, 4> offset_rate = Eigen::Matrix<double, 3, 4>::Zero();
+};
+
+// Merges `previous` into `current`; a merged point's offset_rate is ∂(T·p)/∂δ.
+LidarEdges MergeEdges(const LidarEdges& current, const std::vector<SweepInMap>& previous);
 
 }  // namespace stcalib

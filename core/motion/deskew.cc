@@ -31,4 +31,12 @@ Rigid3d RelativeLidarPose(const LidarPoseFunction& T_world_lidar, double t_to_s,
   return T_world_lidar(t_to_s).inverse() * T_world_lidar(t_from_s);
 }
 
+Eigen::Matrix<double, 3, 4> RelativeLidarPoseRate(const LidarPoseFunction& T_world_lidar,
+                                                  double t_to_s, double t_from_s) {
+  constexpr double kStepS = 0.005;
+  const Rigid3d later = RelativeLidarPose(T_world_lidar, t_to_s + kStepS, t_from_s + kStepS);
+  const Rigid3d earlier = RelativeLidarPose(T_world_lidar, t_to_s - kStepS, t_from_s - kStepS);
+  return (later.matrix() - earlier.matrix()).topRows<3>() / (2 * kStepS);
+}
+
 }  // namespace stcalib

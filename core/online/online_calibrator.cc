@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 namespace stcalib {
 namespace {
@@ -175,25 +176,45 @@ FrameReport OnlineCalibrator::Polish() {
     return report;
   }
   const auto start = std::chrono::steady_clock::now();
-  // Rotation only (see the header).
+  // Rotation, δ and the translation along the direction of travel (see the header).
   RefineOptions refine_options = options_.refine;
-  refine_options.estimate_translation = false;
-  refine_options.estimate_time_offset = false;
+  refine_options.translation = RefineOptions::Translation::kAlongTravel;
   report.refine = Refine(frames, state_, state_, anchor_, refine_options);
+  // The forward translation and δ move together or not at all: where the window cannot separate
+  // them, one alone would slide along their ridge. Then the rotation is refined again with both
+  // held, so that it does not follow their drift.
+  const RefineResult pair = report.refine;
+  const bool pair_observable = pair.usable && pair.covariance_ok &&
+                               pair.forward_std_m < refine_options.observable_translation_m &&
+                               (!refine_options.estimate_time_offset || pair.observable[6]);
+  if (!pair_observable) {
+    refine_options.translation = RefineOptions::Translation::kHeld;
+    refine_options.estimate_time_offset = false;
+    report.refine = Refine(frames, state_, state_, anchor_, refine_options);
+  }
   report.refine_ms = MillisecondsSince(start);
   if (!report.refine.usable) {
     report.reason = "polish: refinement failed (" + report.refine.message + ")";
     return report;
   }
-  const CalibrationState polished =
-      KeepObservableAxes(state_, report.refine.state, report.refine.observable);
+  std::array<bool, kNumAxes> move = report.refine.observable;
+  for (int k = 3; k < kNumAxes; ++k) move[k] = pair_observable;
+  if (!refine_options.estimate_time_offset) move[6] = false;
+  const CalibrationState polished = KeepObservableAxes(state_, report.refine.state, move);
   if (!WithinBounds(polished, anchor_, options_.search)) {
     report.reason = "polish: the refined estimate leaves the bounds";
     return report;
   }
   report.after = state_ = polished;
   report.accepted = true;
-  report.reason = "polish: refined over " + std::to_string(frames.size()) + " frames";
+  char pair_text[160] = "";
+  if (pair.covariance_ok) {
+    std::snprintf(pair_text, sizeof(pair_text),
+                  "; forward translation and δ %s (std %.1f cm, %.1f ms, correlation %+.2f)",
+                  pair_observable ? "refined" : "held", 100 * pair.forward_std_m,
+                  1000 * pair.std_dev[6], pair.time_forward_correlation);
+  }
+  report.reason = "polish: refined over " + std::to_string(frames.size()) + " frames" + pair_text;
   // On the search window, like a frame's.
   WindowScorer scorer(SearchWindow(), options_.score);
   MeasureEstimate(&scorer, true, &report);

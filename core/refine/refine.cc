@@ -8,6 +8,7 @@
 #include <cmath>
 #include <memory>
 
+#include "core/refine/along_direction_manifold.h"
 #include "cost_functions/calibration_prior_cost.h"
 #include "cost_functions/edge_alignment_cost.h"
 
@@ -48,16 +49,32 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
                     start.T_camera_lidar.translation().z()};
   double delta =
       std::clamp(start.time_offset_s, -options.time_offset_bound_s, options.time_offset_bound_s);
+  // The direction of travel in the camera frame (the window's last LiDAR velocity).
+  const LidarTwist& last_twist = window.back()->twist;
+  const Eigen::Vector3d forward =
+      last_twist.linear_m_s.norm() > 0.5
+          ? Eigen::Vector3d(start.T_camera_lidar.linear() * last_twist.linear_m_s.normalized())
+          : Eigen::Vector3d::UnitZ();
+  using Translation = RefineOptions::Translation;
   ceres::Problem problem;
-  if (options.estimate_translation) {
-    problem.AddParameterBlock(
-        pose, 7,
-        new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>());
-  } else {
-    problem.AddParameterBlock(
-        pose, 7,
-        new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::SubsetManifold>(
-            ceres::EigenQuaternionManifold(), ceres::SubsetManifold(3, {0, 1, 2})));
+  switch (options.translation) {
+    case Translation::kFree:
+      problem.AddParameterBlock(pose, 7,
+                                new ceres::ProductManifold<ceres::EigenQuaternionManifold,
+                                                           ceres::EuclideanManifold<3>>());
+      break;
+    case Translation::kAlongTravel:
+      problem.AddParameterBlock(
+          pose, 7,
+          new ceres::ProductManifold<ceres::EigenQuaternionManifold, AlongDirectionManifold>(
+              ceres::EigenQuaternionManifold(), AlongDirectionManifold(forward)));
+      break;
+    case Translation::kHeld:
+      problem.AddParameterBlock(
+          pose, 7,
+          new ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::SubsetManifold>(
+              ceres::EigenQuaternionManifold(), ceres::SubsetManifold(3, {0, 1, 2})));
+      break;
   }
   problem.AddParameterBlock(&delta, 1);
   // The loss is applied per point inside EdgeAlignmentCost (one residual block per frame).
@@ -91,7 +108,17 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
       const double w = frame->kinds[i] == EdgeKind::kHorizontal ? options.horizontal_weight
                                                                 : 1.0 - options.horizontal_weight;
       if (w <= 0) continue;
-      points.push_back({frame->points_lidar[i], w, static_cast<int>(frame->kinds[i])});
+      // A point merged from an earlier sweep is placed at the start's δ (CalibrationFrame::
+      // offset_rates) and held there during the solve; successive refinements follow δ. Left at
+      // the stamps, the map biased δ and the forward translation along their ridge in proportion
+      // to δ (simulated drives started at the truth, δ = 60 ms: the polish moved forward +3.5 to
+      // +11 cm; placed, under 1 cm). Moving with δ inside the solve gave +1 to +5 cm: its
+      // derivative, from the oxts rates, is no information on δ to go by.
+      const Eigen::Vector3d p = frame->offset_rates.empty()
+                                    ? frame->points_lidar[i]
+                                    : Eigen::Vector3d(frame->points_lidar[i] +
+                                                      start.time_offset_s * frame->offset_rates[i]);
+      points.push_back({p, w, static_cast<int>(frame->kinds[i])});
     }
     if (points.empty()) continue;
     result.residuals += static_cast<int>(points.size());
@@ -104,17 +131,16 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
         "too few LiDAR edge points to refine (" + std::to_string(result.residuals) + ")";
     return result;
   }
-  // Translation prior: weak across the direction of travel, per point along it.
-  const LidarTwist& twist = window.back()->twist;
-  const Eigen::Vector3d forward =
-      twist.linear_m_s.norm() > 0.5
-          ? Eigen::Vector3d(start.T_camera_lidar.linear() * twist.linear_m_s.normalized())
-          : Eigen::Vector3d::UnitZ();
-  const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - forward * forward.transpose();
-  const double n = static_cast<double>(result.residuals);
+  // Translation prior: weak across the direction of travel, per point along it (weak along it
+  // too when the translation moves only along it).
+  const Eigen::Matrix3d along = forward * forward.transpose();
+  const double forward_sigma_m =
+      options.translation == Translation::kAlongTravel
+          ? options.prior_sigma_translation_m
+          : options.prior_sigma_forward_m / std::sqrt(static_cast<double>(result.residuals));
   const Eigen::Matrix3d sqrt_information =
-      across / options.prior_sigma_translation_m +
-      std::sqrt(n) / options.prior_sigma_forward_m * forward * forward.transpose();
+      (Eigen::Matrix3d::Identity() - along) / options.prior_sigma_translation_m +
+      along / forward_sigma_m;
   const Eigen::Quaterniond q_prior(rotation_prior.T_camera_lidar.linear());
   problem.AddResidualBlock(
       CalibrationPriorCost::Create(q_prior, mount_prior.T_camera_lidar.translation(),
@@ -155,11 +181,19 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
   std::vector<const double*> blocks = {pose};
   if (options.estimate_time_offset) blocks.push_back(&delta);
   if (covariance.Compute(blocks, &problem)) {
-    // Tangent coordinates → axes: rotation (3), translation (3) when estimated, δ when estimated.
-    std::vector<int> axis_of = {0, 1, 2};
-    if (options.estimate_translation) axis_of.insert(axis_of.end(), {3, 4, 5});
-    if (options.estimate_time_offset) axis_of.push_back(6);
-    const int n = static_cast<int>(axis_of.size());
+    // Tangent coordinates → axes (roll, pitch, yaw [deg] about the LiDAR axes, x, y, z [m], δ
+    // [s]). Tangent of EigenQuaternionManifold: q ⊕ δ = [cos|δ|, sin|δ|·δ/|δ|] ⊗ q, a rotation
+    // of 2δ on the camera side; about the LiDAR axes that is 2·Rᵀ·δ.
+    const int translation_size = options.translation == Translation::kFree          ? 3
+                                 : options.translation == Translation::kAlongTravel ? 1
+                                                                                    : 0;
+    const int n = 3 + translation_size + (options.estimate_time_offset ? 1 : 0);
+    Eigen::Matrix<double, kNumAxes, Eigen::Dynamic> J =
+        Eigen::Matrix<double, kNumAxes, Eigen::Dynamic>::Zero(kNumAxes, n);
+    J.block<3, 3>(0, 0) = 2.0 * (180.0 / M_PI) * result.state.T_camera_lidar.linear().transpose();
+    if (translation_size == 3) J.block<3, 3>(3, 3).setIdentity();
+    if (translation_size == 1) J.block<3, 1>(3, 3) = forward;
+    if (options.estimate_time_offset) J(6, n - 1) = 1.0;
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(n, n);
     if (covariance.GetCovarianceMatrixInTangentSpace(blocks, C.data())) {
       const double dof = std::max(1, result.residuals - n);
@@ -169,36 +203,20 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
       // constrain an axis shows it in C, whatever the variance).
       const double sigma2 =
           std::min(2.0 * summary.final_cost / dof, options.loss_scale_px * options.loss_scale_px);
-      // Tangent of EigenQuaternionManifold: q ⊕ δ = [cos|δ|, sin|δ|·δ/|δ|] ⊗ q, a rotation of
-      // 2δ on the camera side; about the LiDAR axes that is 2·Rᵀ·δ.
-      Eigen::Matrix<double, kNumAxes, kNumAxes> J =
-          Eigen::Matrix<double, kNumAxes, kNumAxes>::Zero();
-      J.block<3, 3>(0, 0) = 2.0 * (180.0 / M_PI) * result.state.T_camera_lidar.linear().transpose();
-      J.block<3, 3>(3, 3).setIdentity();
-      J(6, 6) = 1.0;
-      Eigen::Matrix<double, kNumAxes, kNumAxes> full =
-          Eigen::Matrix<double, kNumAxes, kNumAxes>::Zero();
-      for (int a = 0; a < n; ++a) {
-        for (int b = 0; b < n; ++b) full(axis_of[a], axis_of[b]) = C(a, b) * sigma2;
-      }
-      const Eigen::Matrix<double, kNumAxes, kNumAxes> axes = J * full * J.transpose();
+      const Eigen::Matrix<double, kNumAxes, kNumAxes> axes = J * (sigma2 * C) * J.transpose();
       for (int k = 0; k < kNumAxes; ++k) result.std_dev[k] = std::sqrt(std::max(0.0, axes(k, k)));
-      if (!options.estimate_time_offset) result.std_dev[6] = 0;
-      if (!options.estimate_translation) result.std_dev.segment<3>(3).setZero();
       for (int a = 0; a < kNumAxes; ++a) {
         for (int b = 0; b < kNumAxes; ++b) {
           const double d = result.std_dev[a] * result.std_dev[b];
           result.correlation(a, b) = d > 0 ? axes(a, b) / d : (a == b ? 1.0 : 0.0);
         }
       }
-      // δ against the translation along the direction of travel (camera frame).
-      const LidarTwist& twist = window.back()->twist;
-      if (options.estimate_time_offset && twist.linear_m_s.norm() > 0.5) {
-        const Eigen::Vector3d forward =
-            result.state.T_camera_lidar.linear() * twist.linear_m_s.normalized();
-        const double var_f = forward.transpose() * axes.block<3, 3>(3, 3) * forward;
+      // The translation along the direction of travel, and δ against it.
+      const double var_f = forward.transpose() * axes.block<3, 3>(3, 3) * forward;
+      result.forward_std_m = std::sqrt(std::max(0.0, var_f));
+      if (options.estimate_time_offset && last_twist.linear_m_s.norm() > 0.5) {
         const double cov_fd = forward.dot(axes.block<3, 1>(3, 6));
-        const double d = std::sqrt(std::max(0.0, var_f)) * result.std_dev[6];
+        const double d = result.forward_std_m * result.std_dev[6];
         result.time_forward_correlation = d > 0 ? cov_fd / d : 0.0;
       }
       result.covariance_ok = true;
@@ -214,7 +232,7 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
     result.observable[k] = result.covariance_ok && result.std_dev[k] < thresholds[k];
   }
   if (!options.estimate_time_offset) result.observable[6] = false;
-  if (!options.estimate_translation) {
+  if (options.translation == Translation::kHeld) {
     for (int k = 3; k < 6; ++k) result.observable[k] = false;
   }
   return result;

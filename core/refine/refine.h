@@ -32,7 +32,13 @@ struct RefineOptions {
   double prior_sigma_time_s = 0.03;   ///< [s]
   double time_offset_bound_s = 0.15;  ///< |δ| bound [s]
   bool estimate_time_offset = true;
-  bool estimate_translation = true;  ///< false: the translation stays at the start's
+  // How the translation may move. kAlongTravel: only along the direction of travel (a
+  // one-dimensional manifold through the start; the window's last LiDAR velocity, in the camera
+  // frame), under the weak prior_sigma_translation_m instead of the firm forward prior, so that
+  // the data decides where δ and the forward translation sit wherever it separates the two
+  // (speed changes, turns) and the covariance says where it does not.
+  enum class Translation { kFree, kAlongTravel, kHeld };
+  Translation translation = Translation::kFree;
   int max_points_per_frame = 300;
   int max_iterations = 12;
   // Observability thresholds on the standard deviations.
@@ -60,8 +66,10 @@ struct RefineResult {
   Eigen::Matrix<double, kNumAxes, kNumAxes> correlation =
       Eigen::Matrix<double, kNumAxes, kNumAxes>::Identity();
   std::array<bool, kNumAxes> observable{};
-  // Correlation of δ with the translation along the direction of travel (camera frame).
+  // Correlation of δ with the translation along the direction of travel (camera frame), and the
+  // standard deviation of that translation [m].
   double time_forward_correlation = 0;
+  double forward_std_m = 1e9;
 };
 
 // `rotation_prior` holds the rotation (the search result), `mount_prior` the translation and

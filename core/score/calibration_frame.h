@@ -22,6 +22,8 @@ struct CalibrationFrame {
   CameraModel camera;        ///< size read from the image
   std::vector<Eigen::Vector3d> points_lidar;  ///< edge points (local map), at the LiDAR stamp
   std::vector<EdgeKind> kinds;
+  // ∂p/∂δ [m/s] (LidarEdges::offset_rate), read by the refinement; empty: all zero.
+  std::vector<Eigen::Vector3d> offset_rates;
   ImageFeatures image;  ///< distance_raw_px for overlays
   // Maps per edge kind, indexed by EdgeKind (0 vertical, 1 horizontal): with oriented maps a
   // vertical LiDAR edge reads the map of near-vertical image edges only; otherwise both entries

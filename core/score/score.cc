@@ -287,6 +287,7 @@ std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& fra
   auto pruned = std::make_shared<CalibrationFrame>(frame);
   pruned->points_lidar.clear();
   pruned->kinds.clear();
+  pruned->offset_rates.clear();
   const double mu = margin * frame.camera.width;
   const double mv = margin * frame.camera.height;
   for (size_t i = 0; i < frame.size(); ++i) {
@@ -298,6 +299,7 @@ std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& fra
     }
     pruned->points_lidar.push_back(frame.points_lidar[i]);
     pruned->kinds.push_back(frame.kinds[i]);
+    if (!frame.offset_rates.empty()) pruned->offset_rates.push_back(frame.offset_rates[i]);
   }
   return pruned;
 }
