@@ -89,6 +89,9 @@ DEFINE_double(observable_translation_m, kOnline.refine.observable_translation_m,
               "refine: a translation axis is observable below this std [m]");
 DEFINE_double(observable_time_s, kOnline.refine.observable_time_s,
               "refine: δ is observable below this std [s]");
+DEFINE_double(polish_forward_std_m, kOnline.polish_forward_std_m,
+              "calibrate: the polish moves δ with the forward translation only below this "
+              "forward std [m]");
 DEFINE_double(min_health, kConvergence.health_check.min_health,
               "check, calibrate: the calibration holds when the mean health reaches this");
 DEFINE_bool(check_suppressed_health, kConvergence.check_suppressed_health,

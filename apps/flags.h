@@ -47,6 +47,7 @@ DECLARE_double(tracking_gain);
 DECLARE_int32(tracking_update_every);
 DECLARE_double(observable_rotation_deg);
 DECLARE_double(observable_translation_m);
+DECLARE_double(polish_forward_std_m);
 DECLARE_double(observable_time_s);
 DECLARE_double(min_health);
 DECLARE_bool(check_suppressed_health);

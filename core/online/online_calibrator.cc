@@ -33,6 +33,9 @@ CalibrationState KeepObservableAxes(const CalibrationState& old, const Calibrati
 
 Status OnlineCalibratorOptions::Validate() const {
   if (window_frames < 1) return Status::Error("online: window_frames must be >= 1");
+  if (!(polish_forward_std_m >= 0)) {
+    return Status::Error("online: polish_forward_std_m must be >= 0");
+  }
   if (tracking_update_every < 1) {
     return Status::Error("online: tracking_update_every must be >= 1");
   }
@@ -185,7 +188,7 @@ FrameReport OnlineCalibrator::Polish() {
   // held, so that it does not follow their drift.
   const RefineResult pair = report.refine;
   const bool pair_observable = pair.usable && pair.covariance_ok &&
-                               pair.forward_std_m < refine_options.observable_translation_m &&
+                               pair.forward_std_m < options_.polish_forward_std_m &&
                                (!refine_options.estimate_time_offset || pair.observable[6]);
   if (!pair_observable) {
     refine_options.translation = RefineOptions::Translation::kHeld;

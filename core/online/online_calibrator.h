@@ -37,6 +37,13 @@ struct OnlineCalibratorOptions {
   // the estimate may be far off: the search runs coarse-to-fine from the widest map instead of
   // on the finest one only.
   double lost_health = 0.9;
+  // The polish moves δ with the forward translation only when its refinement puts the forward
+  // translation's std under this [m] (and δ's under refine.observable_time_s). The covariance
+  // treats the edge residuals as independent, which neighbouring points of one edge are not: on
+  // simulated drives the pair's error reached 2-4 std where the std was 2.1-2.9 cm (a 20-frame
+  // drive, started at the truth, ended 12 cm and 14 ms off), and stayed within 2.9 cm where it
+  // was 1.0-2.0 cm (13 windows on three rigs).
+  double polish_forward_std_m = 0.02;
   bool coarse_until_window_full = true;
   // No update before the search window holds window_frames frames: one frame's score can have
   // its best optimum degrees away (a simulated drive, frame 0 alone: 5.9° off from a 3.5° start).
@@ -150,12 +157,11 @@ class OnlineCalibrator {
   // forward translation is held at the start's and δ absorbs its error (δ error = forward error ÷
   // speed); over the whole window, speed changes and turns can separate the two. The forward
   // translation and δ move together when both are observable (forward std under
-  // observable_translation_m, δ std under observable_time_s); otherwise both stay and the rotation
-  // is refined again with them held (simulated drives: 12 of 14 separate them, 1-2.5 cm; KITTI's
-  // 30 frames do not, 4.2 cm). The lateral and vertical translation stay because edges pin them
-  // down only to a few cm (a free one moved 4 cm on KITTI). Nothing changes while acquiring, when
-  // the last frame's health is below lost_health, or when the refinement fails or leaves the
-  // bounds; the report says what happened.
+  // polish_forward_std_m, δ std under refine.observable_time_s); otherwise both stay and the
+  // rotation is refined again with them held (KITTI's 30 frames do not separate them: 4.2 cm). The
+  // lateral and vertical translation stay because edges pin them down only to a few cm (a free one
+  // moved 4 cm on KITTI). Nothing changes while acquiring, when the last frame's health is below
+  // lost_health, or when the refinement fails or leaves the bounds; the report says what happened.
   FrameReport Polish();
   // Replaces the estimate (the paper's disturbance protocol); the bounds stay where they were.
   // The next frame updates whatever tracking_update_every says.
