@@ -68,15 +68,16 @@ using DistanceInterpolator = ceres::BiCubicInterpolator<DistanceGrid>;
 // Ceres' per-block bookkeeping is paid 20 times, not 6000 (BM_Refine/12: see benchmarks).
 //
 // Parameters: the extrinsic T_camera_lidar as one block [qx, qy, qz, qw, tx, ty, tz] (Eigen
-// quaternion order, on ProductManifold<EigenQuaternionManifold, EuclideanManifold<3>>) and the
-// time offset δ [s] as its own block. A point that falls behind the camera or outside the image
+// quaternion order, on a ProductManifold of EigenQuaternionManifold and a translation manifold:
+// free, along the direction of travel, or held; see RefineOptions) and the time offset δ [s] as
+// its own block. A point that falls behind the camera or outside the image
 // costs the constant `outside_px` (the map's cap) with zero derivative: it is dropped for that
 // evaluation rather than clamped to the border, and leaving the image is never a way to lower
 // the cost.
 class EdgeAlignmentCost : public ceres::CostFunction {
  public:
   struct Point {
-    Eigen::Vector3d p_lidar;  ///< de-skewed to the sweep stamp [m]
+    Eigen::Vector3d p_lidar;  ///< de-skewed to the sweep stamp (local map: placed at δ) [m]
     double weight = 1;        ///< w > 0
     int kind = 0;             ///< index into the maps (EdgeKind)
   };

@@ -564,6 +564,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   auto empty = std::make_shared<CalibrationFrame>(*frames.back());
   empty->points_lidar.clear();
   empty->kinds.clear();
+  empty->offset_rates.clear();
   OnlineCalibratorOptions single;
   single.window_frames = 1;
   single.refine_frames = 1;

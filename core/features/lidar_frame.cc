@@ -168,6 +168,7 @@ Status LoadLidarFrameFeatures(const Drive& drive, const DriveMotion& motion, siz
 LidarEdges MergeEdges(const LidarEdges& current, const std::vector<SweepInMap>& previous) {
   LidarEdges map = current;
   for (const SweepInMap& sweep : previous) {
+    CHECK_EQ(sweep.edges->offset_rate.size(), sweep.edges->size());
     LidarEdges moved = *sweep.edges;
     const Rigid3d& T = sweep.T_current_previous;
     for (size_t i = 0; i < moved.size(); ++i) {
@@ -231,10 +232,14 @@ Status SweepCache::LocalMap(size_t frame, const LocalMapOptions& map_options, Li
           (result.T_target_source.translation() - T.translation()).norm());
       T = result.T_target_source;
     }
-    // The rate from the motion (NDT corrects the pose at the stamps, not its rate).
-    previous.push_back(
-        {&sweeps[k]->edges, T,
-         RelativeLidarPoseRate(motion_.PoseFunction(), current.stamp_s, sweeps[k]->stamp_s)});
+    // Poses from the oxts, looked up at the LiDAR stamps, are off with δ; NDT and a motion from
+    // scan registration relate the sweeps themselves, so their relative pose holds at any δ.
+    SweepInMap sweep{&sweeps[k]->edges, T};
+    if (!map_options.use_ndt && motion_.source() == DriveMotion::Source::kOxts) {
+      sweep.offset_rate =
+          RelativeLidarPoseRate(motion_.PoseFunction(), current.stamp_s, sweeps[k]->stamp_s);
+    }
+    previous.push_back(sweep);
   }
   *map = MergeEdges(current.edges, previous);
   stats->sweeps_used = static_cast<int>(sweeps.size());

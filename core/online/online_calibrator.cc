@@ -182,10 +182,12 @@ FrameReport OnlineCalibrator::Polish() {
   // Rotation, δ and the translation along the direction of travel (see the header).
   RefineOptions refine_options = options_.refine;
   refine_options.translation = RefineOptions::Translation::kAlongTravel;
+  refine_options.place_at_time_offset = true;
   report.refine = Refine(frames, state_, state_, anchor_, refine_options);
   // The forward translation and δ move together or not at all: where the window cannot separate
   // them, one alone would slide along their ridge. Then the rotation is refined again with both
-  // held, so that it does not follow their drift.
+  // held, so that it does not follow their drift. (With δ not estimated there is no ridge and the
+  // forward translation moves alone when its std allows.)
   const RefineResult pair = report.refine;
   const bool pair_observable = pair.usable && pair.covariance_ok &&
                                pair.forward_std_m < options_.polish_forward_std_m &&

@@ -102,22 +102,19 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
     const size_t n = frame->size();
     const size_t keep =
         options.max_points_per_frame > 0 ? std::min<size_t>(n, options.max_points_per_frame) : n;
+    // Points merged from earlier sweeps placed at the start's δ (RefineOptions::
+    // place_at_time_offset).
+    const bool place = options.place_at_time_offset && !frame->offset_rates.empty();
+    CHECK(frame->offset_rates.empty() || frame->offset_rates.size() == n);
     std::vector<EdgeAlignmentCost::Point> points;
     for (size_t k = 0; k < keep; ++k) {
       const size_t i = k * n / keep;
       const double w = frame->kinds[i] == EdgeKind::kHorizontal ? options.horizontal_weight
                                                                 : 1.0 - options.horizontal_weight;
       if (w <= 0) continue;
-      // A point merged from an earlier sweep is placed at the start's δ (CalibrationFrame::
-      // offset_rates) and held there during the solve; successive refinements follow δ. Left at
-      // the stamps, the map biased δ and the forward translation along their ridge in proportion
-      // to δ (simulated drives started at the truth, δ = 60 ms: the polish moved forward +3.5 to
-      // +11 cm; placed, under 1 cm). Moving with δ inside the solve gave +1 to +5 cm: its
-      // derivative, from the oxts rates, is no information on δ to go by.
-      const Eigen::Vector3d p = frame->offset_rates.empty()
-                                    ? frame->points_lidar[i]
-                                    : Eigen::Vector3d(frame->points_lidar[i] +
-                                                      start.time_offset_s * frame->offset_rates[i]);
+      const Eigen::Vector3d p =
+          place ? Eigen::Vector3d(frame->points_lidar[i] + delta * frame->offset_rates[i])
+                : frame->points_lidar[i];
       points.push_back({p, w, static_cast<int>(frame->kinds[i])});
     }
     if (points.empty()) continue;

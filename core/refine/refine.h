@@ -24,8 +24,9 @@ struct RefineOptions {
   // Weak priors: rotation towards the search result, translation and δ towards the mount (the
   // initial calibration); they hold only what the data leaves free (δ against the forward
   // translation on a straight road, method.md §10).
-  double prior_sigma_rotation_deg = 2.0;    ///< [deg]
-  double prior_sigma_translation_m = 0.05;  ///< lateral and vertical [m]
+  double prior_sigma_rotation_deg = 2.0;  ///< [deg]
+  double prior_sigma_translation_m =
+      0.05;  ///< lateral and vertical (kAlongTravel: forward too) [m]
   // Along the direction of travel the translation is held firmly (per point, i.e. the sigma is
   // scaled by √N): there data cannot tell it from δ on a straight road (method.md §10).
   double prior_sigma_forward_m = 0.05;
@@ -39,6 +40,15 @@ struct RefineOptions {
   // (speed changes, turns) and the covariance says where it does not.
   enum class Translation { kFree, kAlongTravel, kHeld };
   Translation translation = Translation::kFree;
+  // The local map's earlier sweeps were merged with the poses at the LiDAR stamps, which are off
+  // by δ: place each merged point at the start's δ (CalibrationFrame::offset_rates) and hold it
+  // there during the solve. Left at the stamps, the map biased δ and the forward translation
+  // along their ridge in proportion to δ (simulated drives started at the truth, δ = 60 ms: the
+  // polish moved forward +3.5 to +11 cm; placed, under 1 cm). Moving with δ inside the solve
+  // gave +1 to +5 cm: its derivative, from the oxts rates, is no information on δ to go by. Off
+  // while tracking: there a placement at a δ still far off holds δ there (KITTI from δ0 =
+  // +50 ms: δ stayed at +33 ms, not converged, where the stamps' map ends at +9.5 ms, converged).
+  bool place_at_time_offset = false;
   int max_points_per_frame = 300;
   int max_iterations = 12;
   // Observability thresholds on the standard deviations.

@@ -284,6 +284,7 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
 
 std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& frame,
                                                      const CalibrationState& state, double margin) {
+  CHECK(frame.offset_rates.empty() || frame.offset_rates.size() == frame.size());
   auto pruned = std::make_shared<CalibrationFrame>(frame);
   pruned->points_lidar.clear();
   pruned->kinds.clear();
