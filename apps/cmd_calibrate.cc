@@ -133,8 +133,8 @@ CalibrateJob CalibrateJobFromFlags() {
   o.tracking_update_every = FLAGS_tracking_update_every;
   o.refine.observable_rotation_deg = FLAGS_observable_rotation_deg;
   o.refine.observable_translation_m = FLAGS_observable_translation_m;
-  o.polish_forward_std_m = FLAGS_polish_forward_std_m;
   o.refine.observable_time_s = FLAGS_observable_time_s;
+  o.polish_forward_std_m = FLAGS_polish_forward_std_m;
   job.source.local_map.sweeps = FLAGS_local_map_sweeps;
   job.source.local_map.use_ndt = FLAGS_use_ndt;
   job.source.lidar.remove_dynamic = FLAGS_remove_dynamic;
