@@ -310,7 +310,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const FrameReport& final_report = outcome->polish.accepted ? outcome->polish : *final_report_ptr;
   const int skipped = verdict.skipped_frames;
   const std::vector<std::string>& unobservable = verdict.unobservable_axes;
-  // The covariance is the refinement the verdict read (the polish holds the translation).
+  // The covariance is the refinement the verdict read (what the polish did with the forward
+  // translation and δ is in polish.reason).
   const RefineResult& refine = verdict.refine;
 
   // Outputs.

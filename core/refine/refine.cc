@@ -50,11 +50,12 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
   double delta =
       std::clamp(start.time_offset_s, -options.time_offset_bound_s, options.time_offset_bound_s);
   // The direction of travel in the camera frame (the window's last LiDAR velocity).
+  // Below 0.5 m/s there is none: the camera axis stands in, and δ is then unobservable.
   const LidarTwist& last_twist = window.back()->twist;
+  const bool moving = last_twist.linear_m_s.norm() > 0.5;
   const Eigen::Vector3d forward =
-      last_twist.linear_m_s.norm() > 0.5
-          ? Eigen::Vector3d(start.T_camera_lidar.linear() * last_twist.linear_m_s.normalized())
-          : Eigen::Vector3d::UnitZ();
+      moving ? Eigen::Vector3d(start.T_camera_lidar.linear() * last_twist.linear_m_s.normalized())
+             : Eigen::Vector3d::UnitZ();
   using Translation = RefineOptions::Translation;
   ceres::Problem problem;
   switch (options.translation) {
@@ -211,7 +212,7 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
       // The translation along the direction of travel, and δ against it.
       const double var_f = forward.transpose() * axes.block<3, 3>(3, 3) * forward;
       result.forward_std_m = std::sqrt(std::max(0.0, var_f));
-      if (options.estimate_time_offset && last_twist.linear_m_s.norm() > 0.5) {
+      if (options.estimate_time_offset && moving) {
         const double cov_fd = forward.dot(axes.block<3, 1>(3, 6));
         const double d = result.forward_std_m * result.std_dev[6];
         result.time_forward_correlation = d > 0 ? cov_fd / d : 0.0;

@@ -25,8 +25,8 @@ struct RefineOptions {
   // initial calibration); they hold only what the data leaves free (δ against the forward
   // translation on a straight road, method.md §10).
   double prior_sigma_rotation_deg = 2.0;  ///< [deg]
-  double prior_sigma_translation_m =
-      0.05;  ///< lateral and vertical (kAlongTravel: forward too) [m]
+  // Lateral and vertical (with Translation::kAlongTravel, forward too) [m].
+  double prior_sigma_translation_m = 0.05;
   // Along the direction of travel the translation is held firmly (per point, i.e. the sigma is
   // scaled by √N): there data cannot tell it from δ on a straight road (method.md §10).
   double prior_sigma_forward_m = 0.05;
