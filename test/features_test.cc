@@ -53,6 +53,41 @@ TEST(ImageFeatures, RectangleGivesExactDistanceAndIdt) {
   EXPECT_EQ(f.distance_px.type(), CV_32F);
 }
 
+// The chamfer transform is OpenCV's DIST_L2 / DIST_MASK_3 transform, bit for bit: on random
+// masks of several sizes and densities (single rows and columns, one pixel, none) and on the
+// Canny edges of a KITTI frame.
+TEST(ImageFeatures, ChamferDistanceEqualsOpenCvsThreeByThreeTransform) {
+  auto expect_equal = [](const cv::Mat& edges, const std::string& what) {
+    cv::Mat ours, theirs;
+    ChamferDistance(edges, &ours);
+    cv::distanceTransform(edges == 0, theirs, cv::DIST_L2, cv::DIST_MASK_3);
+    ASSERT_EQ(ours.type(), CV_32F) << what;
+    ASSERT_EQ(ours.size(), edges.size()) << what;
+    cv::Mat differs = ours != theirs;
+    EXPECT_EQ(cv::countNonZero(differs), 0) << what;
+  };
+  cv::RNG rng(7);
+  for (const cv::Size size : {cv::Size(1, 1), cv::Size(1, 37), cv::Size(53, 1), cv::Size(61, 29),
+                              cv::Size(200, 120), cv::Size(333, 77)}) {
+    for (const double density : {0.0, 0.001, 0.02, 0.3}) {
+      cv::Mat uniform(size, CV_32F);
+      rng.fill(uniform, cv::RNG::UNIFORM, 0.0, 1.0);
+      cv::Mat edges = uniform < density;
+      if (density > 0 && cv::countNonZero(edges) == 0) edges.at<uint8_t>(size.height / 2, 0) = 255;
+      expect_equal(edges, std::to_string(size.width) + "x" + std::to_string(size.height) +
+                              " at density " + std::to_string(density));
+    }
+  }
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  cv::Mat image;
+  ASSERT_TRUE(drive.LoadImage(0, &image).ok());
+  const ImageFeatures f = ExtractImageFeatures(image, ImageFeatureOptions());
+  ASSERT_GT(f.edge_pixels, 5000);
+  expect_equal(f.edge_mask, "KITTI frame 0's edges");
+}
+
 TEST(ImageFeatures, RegionOfInterestMatchesTheFullImageInside) {
   cv::Mat image(120, 200, CV_8UC3, cv::Scalar(0, 0, 0));
   cv::rectangle(image, cv::Rect(60, 60, 80, 40), cv::Scalar(255, 255, 255), cv::FILLED);
