@@ -265,14 +265,27 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
   if (options.split_orientation) {
     // Gradient mostly along x = a near-vertical line; the 30° band in between (diagonal lines)
     // goes to neither.
+    // The 3×3 Sobel of 8-bit grey levels is an integer of at most 4·255 in magnitude: 16 bits
+    // hold it exactly. One pass over the edge pixels sorts them.
     cv::Mat gx, gy;
-    cv::Sobel(blurred, gx, CV_32F, 1, 0, 3);
-    cv::Sobel(blurred, gy, CV_32F, 0, 1, 3);
-    const cv::Mat abs_gx = cv::abs(gx), abs_gy = cv::abs(gy);
-    const cv::Mat vertical =
-        (abs_gx * 0.577f >= abs_gy) & features.edge_mask;  // within 30° of vertical
-    const cv::Mat horizontal =
-        (abs_gy * 0.577f >= abs_gx) & features.edge_mask;  // within 30° of horizontal
+    cv::Sobel(blurred, gx, CV_16S, 1, 0, 3);
+    cv::Sobel(blurred, gy, CV_16S, 0, 1, 3);
+    cv::Mat vertical = cv::Mat::zeros(gray.size(), CV_8U);
+    cv::Mat horizontal = cv::Mat::zeros(gray.size(), CV_8U);
+    for (int y = 0; y < gray.rows; ++y) {
+      const uint8_t* edge = features.edge_mask.ptr<uint8_t>(y);
+      const int16_t* dx = gx.ptr<int16_t>(y);
+      const int16_t* dy = gy.ptr<int16_t>(y);
+      uint8_t* v = vertical.ptr<uint8_t>(y);
+      uint8_t* h = horizontal.ptr<uint8_t>(y);
+      for (int x = 0; x < gray.cols; ++x) {
+        if (!edge[x]) continue;
+        const float ax = static_cast<float>(std::abs(dx[x]));
+        const float ay = static_cast<float>(std::abs(dy[x]));
+        v[x] = ax * 0.577f >= ay ? edge[x] : 0;  // within 30° of vertical
+        h[x] = ay * 0.577f >= ax ? edge[x] : 0;  // within 30° of horizontal
+      }
+    }
     distance_to(vertical, &features.distance_vertical_raw_px);
     distance_to(horizontal, &features.distance_horizontal_raw_px);
   }
