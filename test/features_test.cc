@@ -88,6 +88,37 @@ TEST(ImageFeatures, ChamferDistanceEqualsOpenCvsThreeByThreeTransform) {
   expect_equal(f.edge_mask, "KITTI frame 0's edges");
 }
 
+// The features' IDT comes from the smoothed capped distance by the affine map (one blur for both):
+// it equals InverseDistanceTransform of the raw distance up to float rounding, unsplit and per
+// orientation, and the capped distance stays within [0, basin].
+TEST(ImageFeatures, IdtIsTheAffineImageOfTheSmoothedCappedDistance) {
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  cv::Mat image;
+  ASSERT_TRUE(drive.LoadImage(3, &image).ok());
+  ImageFeatureOptions options;
+  options.split_orientation = true;
+  const ImageFeatures f = ExtractImageFeatures(image, options);
+  ASSERT_FALSE(f.empty());
+  auto max_difference = [&](const cv::Mat& idt, const cv::Mat& raw) {
+    const cv::Mat reference =
+        InverseDistanceTransform(raw, options.basin_px, options.smoothing_sigma_px);
+    double worst = 0, peak = 0;
+    cv::minMaxLoc(cv::abs(idt - reference), nullptr, &worst);
+    cv::minMaxLoc(reference, nullptr, &peak);
+    EXPECT_GT(peak, 200.0);  // edges present: the comparison is not between flat maps
+    return worst;
+  };
+  EXPECT_LT(max_difference(f.idt, f.distance_raw_px), 1e-3);
+  EXPECT_LT(max_difference(f.oriented[0].idt, f.distance_vertical_raw_px), 1e-3);
+  EXPECT_LT(max_difference(f.oriented[1].idt, f.distance_horizontal_raw_px), 1e-3);
+  double low = 0, high = 0;
+  cv::minMaxLoc(f.oriented[0].distance_px, &low, &high);
+  EXPECT_GE(low, 0.0);
+  EXPECT_LE(high, options.basin_px + 1e-3);
+}
+
 TEST(ImageFeatures, RegionOfInterestMatchesTheFullImageInside) {
   cv::Mat image(120, 200, CV_8UC3, cv::Scalar(0, 0, 0));
   cv::rectangle(image, cv::Rect(60, 60, 80, 40), cv::Scalar(255, 255, 255), cv::FILLED);

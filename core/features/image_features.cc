@@ -50,6 +50,17 @@ std::vector<cv::Vec4f> DetectSegments(const cv::Mat& gray, const ImageFeatureOpt
   return segments;
 }
 
+// The smoothed capped distance min(D, basin) and the IDT. The IDT 255·max(0, 1 − D/basin) is
+// 255·(1 − min(D, basin)/basin), an affine map of the capped distance, and the Gaussian blur is
+// linear (unit kernel sum, the same border), so one blur serves both: the IDT equals
+// InverseDistanceTransform(D, basin, σ) up to float rounding.
+void CappedDistanceAndIdt(const cv::Mat& distance_raw_px, const ImageFeatureOptions& options,
+                          cv::Mat* distance_px, cv::Mat* idt) {
+  cv::min(distance_raw_px, options.basin_px, *distance_px);
+  Smooth(distance_px, options.smoothing_sigma_px);
+  distance_px->convertTo(*idt, CV_32F, -255.0 / options.basin_px, 255.0);
+}
+
 // With split orientation the oriented maps carry their own pyramids; an unsplit one would be two
 // wide blurs per level that nothing reads.
 size_t UnsplitPyramidLevels(const ImageFeatureOptions& options) {
@@ -291,11 +302,9 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
   }
   const cv::Mat& distance = features.distance_raw_px;
   if (unsplit) {
-    features.idt = InverseDistanceTransform(distance, options.basin_px, options.smoothing_sigma_px);
+    CappedDistanceAndIdt(distance, options, &features.distance_px, &features.idt);
     features.idt_bandpass = BandPass(features.idt, options.suppression_sigma_px);
     cv::max(features.idt_bandpass, 0.0, features.idt_suppressed);
-    cv::min(distance, options.basin_px, features.distance_px);
-    Smooth(&features.distance_px, options.smoothing_sigma_px);
   }
   for (size_t i = 0; i < UnsplitPyramidLevels(options); ++i) {
     const double basin = options.pyramid_basins_px[i];
@@ -311,11 +320,9 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
                              &features.distance_horizontal_raw_px};
     for (int o = 0; o < 2; ++o) {
       OrientedMaps& m = features.oriented[o];
-      m.idt = InverseDistanceTransform(*raw[o], options.basin_px, options.smoothing_sigma_px);
+      CappedDistanceAndIdt(*raw[o], options, &m.distance_px, &m.idt);
       m.idt_bandpass = BandPass(m.idt, options.suppression_sigma_px);
       cv::max(m.idt_bandpass, 0.0, m.idt_suppressed);
-      cv::min(*raw[o], options.basin_px, m.distance_px);
-      Smooth(&m.distance_px, options.smoothing_sigma_px);
       for (double basin : options.pyramid_basins_px) {
         cv::Mat level = InverseDistanceTransform(*raw[o], basin,
                                                  std::max(options.smoothing_sigma_px, basin / 10));
