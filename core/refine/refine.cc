@@ -11,6 +11,7 @@
 #include "core/refine/along_direction_manifold.h"
 #include "cost_functions/calibration_prior_cost.h"
 #include "cost_functions/edge_alignment_cost.h"
+#include "cost_functions/memoized_cost.h"
 
 namespace stcalib {
 
@@ -120,8 +121,10 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
     }
     if (points.empty()) continue;
     result.residuals += static_cast<int>(points.size());
-    problem.AddResidualBlock(new EdgeAlignmentCost(std::move(points), frame->twist, frame->e0_s,
-                                                   &frame->camera, by_kind, cap, loss.get()),
+    // Memoized: the line search, the candidate and the accepted step evaluate one point thrice.
+    problem.AddResidualBlock(new MemoizedCostFunction(std::make_unique<EdgeAlignmentCost>(
+                                 std::move(points), frame->twist, frame->e0_s, &frame->camera,
+                                 by_kind, cap, loss.get())),
                              nullptr, pose, &delta);
   }
   if (result.residuals < 20) {
