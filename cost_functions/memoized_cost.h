@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -19,7 +20,7 @@ namespace stcalib {
 // the final point once more. The wrapped function is pure, so the repeats return exactly what it
 // would return: the solve is the same bit for bit, at a fraction of the evaluations.
 //
-// A call is answered from memory when every parameter equals the remembered one exactly and every
+// A call is answered from memory when every parameter has the remembered one's bits and every
 // Jacobian it asks for was computed then. Otherwise the wrapped function is evaluated (with the
 // Jacobians asked for) and remembered, when it succeeds. Not for concurrent use: Refine solves with
 // one thread.
@@ -44,7 +45,7 @@ class MemoizedCostFunction final : public ceres::CostFunction {
     const size_t rows = static_cast<size_t>(num_residuals());
     bool hit = valid_;
     for (size_t b = 0, offset = 0; hit && b < sizes.size(); offset += sizes[b], ++b) {
-      hit = std::equal(parameters[b], parameters[b] + sizes[b], parameters_.begin() + offset);
+      hit = std::memcmp(parameters[b], parameters_.data() + offset, sizes[b] * sizeof(double)) == 0;
     }
     for (size_t b = 0; hit && jacobians != nullptr && b < sizes.size(); ++b) {
       hit = jacobians[b] == nullptr || have_jacobian_[b];

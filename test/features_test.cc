@@ -28,6 +28,16 @@ LidarPoseFunction TruthPose(const Simulator& s) {
   return [&s](double t) { return s.trajectory().T_world_imu(t) * s.T_lidar_imu().inverse(); };
 }
 
+// Image `frame` of the shared KITTI drive; empty, with a failure recorded, when it cannot be read.
+cv::Mat KittiImage(size_t frame) {
+  Drive drive;
+  cv::Mat image;
+  Status status = OpenDrive(testing::KittiDriveDir(), "", &drive);
+  if (status.ok()) status = drive.LoadImage(frame, &image);
+  if (!status.ok()) ADD_FAILURE() << status.message();
+  return image;
+}
+
 TEST(ImageFeatures, RectangleGivesExactDistanceAndIdt) {
   cv::Mat image(120, 200, CV_8UC3, cv::Scalar(0, 0, 0));
   cv::rectangle(image, cv::Rect(60, 40, 80, 40), cv::Scalar(255, 255, 255), cv::FILLED);
@@ -79,10 +89,8 @@ TEST(ImageFeatures, ChamferDistanceEqualsOpenCvsThreeByThreeTransform) {
     }
   }
   STCALIB_REQUIRE_KITTI();
-  Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
-  cv::Mat image;
-  ASSERT_TRUE(drive.LoadImage(0, &image).ok());
+  const cv::Mat image = KittiImage(0);
+  ASSERT_FALSE(image.empty());
   const ImageFeatures f = ExtractImageFeatures(image, ImageFeatureOptions());
   ASSERT_GT(f.edge_pixels, 5000);
   expect_equal(f.edge_mask, "KITTI frame 0's edges");
@@ -93,10 +101,8 @@ TEST(ImageFeatures, ChamferDistanceEqualsOpenCvsThreeByThreeTransform) {
 // orientation, and the capped distance stays within [0, basin].
 TEST(ImageFeatures, IdtIsTheAffineImageOfTheSmoothedCappedDistance) {
   STCALIB_REQUIRE_KITTI();
-  Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
-  cv::Mat image;
-  ASSERT_TRUE(drive.LoadImage(3, &image).ok());
+  const cv::Mat image = KittiImage(3);
+  ASSERT_FALSE(image.empty());
   ImageFeatureOptions options;
   options.split_orientation = true;
   const ImageFeatures f = ExtractImageFeatures(image, options);
@@ -251,10 +257,8 @@ TEST(ImageFeatures, BandPassIsZeroMeanOnTextureAndPeaksOnAnIsolatedEdge) {
 
 TEST(ImageFeatures, LineDetectorsFindSegmentsOnKitti) {
   STCALIB_REQUIRE_KITTI();
-  Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
-  cv::Mat image;
-  ASSERT_TRUE(drive.LoadImage(0, &image).ok());
+  const cv::Mat image = KittiImage(0);
+  ASSERT_FALSE(image.empty());
   for (auto detector :
        {ImageFeatureOptions::Detector::kLsd, ImageFeatureOptions::Detector::kFastLine}) {
     ImageFeatureOptions options;

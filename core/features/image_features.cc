@@ -275,9 +275,8 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
   if (unsplit) distance_to(features.edge_mask, &features.distance_raw_px);
   if (options.split_orientation) {
     // Gradient mostly along x = a near-vertical line; the 30° band in between (diagonal lines)
-    // goes to neither.
-    // The 3×3 Sobel of 8-bit grey levels is an integer of at most 4·255 in magnitude: 16 bits
-    // hold it exactly. One pass over the edge pixels sorts them.
+    // goes to neither. The 3×3 Sobel of 8-bit grey levels is an integer of at most 4·255 in
+    // magnitude, so 16 bits hold it exactly; one pass over the edge pixels sorts them.
     cv::Mat gx, gy;
     cv::Sobel(blurred, gx, CV_16S, 1, 0, 3);
     cv::Sobel(blurred, gy, CV_16S, 0, 1, 3);
