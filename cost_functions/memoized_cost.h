@@ -37,6 +37,7 @@ class MemoizedCostFunction final : public ceres::CostFunction {
     residuals_.resize(static_cast<size_t>(num_residuals()));
     jacobians_.resize(parameter_block_sizes().size());
     have_jacobian_.assign(parameter_block_sizes().size(), 0);
+    into_.assign(parameter_block_sizes().size(), nullptr);
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
@@ -53,7 +54,8 @@ class MemoizedCostFunction final : public ceres::CostFunction {
     ++calls_;
     if (!hit) {
       ++evaluations_;
-      std::vector<double*> into(sizes.size(), nullptr);
+      std::vector<double*>& into = into_;
+      std::fill(into.begin(), into.end(), nullptr);
       for (size_t b = 0; jacobians != nullptr && b < sizes.size(); ++b) {
         if (jacobians[b] == nullptr) continue;
         jacobians_[b].resize(rows * static_cast<size_t>(sizes[b]));
@@ -87,6 +89,7 @@ class MemoizedCostFunction final : public ceres::CostFunction {
   mutable std::vector<double> residuals_;
   mutable std::vector<std::vector<double>> jacobians_;  // row-major, per block
   mutable std::vector<uint8_t> have_jacobian_;
+  mutable std::vector<double*> into_;  // where a miss writes its Jacobians (no allocation per call)
   mutable int calls_ = 0, evaluations_ = 0;
 };
 
