@@ -130,6 +130,7 @@ CalibrateJob CalibrateJobFromFlags() {
   o.refine.max_iterations = FLAGS_refine_max_iterations;
   o.refine_frames = FLAGS_refine_frames;
   o.tracking_gain = FLAGS_tracking_gain;
+  o.refined_score_tolerance = FLAGS_refined_score_tolerance;
   o.tracking_update_every = FLAGS_tracking_update_every;
   o.refine.observable_rotation_deg = FLAGS_observable_rotation_deg;
   o.refine.observable_translation_m = FLAGS_observable_translation_m;

@@ -81,6 +81,9 @@ DEFINE_int32(max_points_per_frame, kOnline.refine.max_points_per_frame,
              "refine: LiDAR edge points used per frame");
 DEFINE_double(tracking_gain, kOnline.tracking_gain,
               "calibrate: share of an accepted update taken while tracking");
+DEFINE_double(refined_score_tolerance, kOnline.refined_score_tolerance,
+              "calibrate: the refined rotation is taken when it scores within this share of "
+              "the best candidate (0 = the best score wins)");
 DEFINE_int32(tracking_update_every, kOnline.tracking_update_every,
              "calibrate: while tracking, search and refine on every n-th frame (1 = every frame)");
 DEFINE_double(observable_rotation_deg, kOnline.refine.observable_rotation_deg,

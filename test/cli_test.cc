@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -571,7 +572,7 @@ RunResult CalibrateKitti(const std::string& out, const std::string& args) {
 }
 
 // All 30 frames: the rotation grid finds the band-pass peak, the calibration converges near
-// KITTI's own (measured 0.25–0.32° over seeds 1–4 after the polish, nearly all roll).
+// KITTI's own (measured 0.11–0.29° over seeds 1–4 after the polish, nearly all roll).
 TEST(Cli, CalibratesKittiFromTwoDegrees) {
   STCALIB_REQUIRE_KITTI();
   testing::ScopedTempDir tmp;
@@ -582,8 +583,9 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
   const auto& agreement = result["agreement_with_drive_calibration"];
   EXPECT_TRUE(result["converged"].get<bool>()) << result["reason"];
   EXPECT_EQ(result["motion"], "oxts");
-  // Measured 0.28° (the online estimate was 0.20° off; the polish moved it 0.11° to the
-  // refinement's optimum, which over these frames lies 0.25-0.32° from KITTI's on roll).
+  // Measured 0.29° (the refinement's optimum over these frames lies 0.11-0.37° from KITTI's on
+  // roll, 16 starts of 1-3°: where the polish ends moves by a few hundredths of a degree with
+  // where it starts).
   EXPECT_LT(agreement["rotation_deg"].get<double>(), 0.35) << r.output;
   EXPECT_LT(agreement["translation_m"].get<double>(), 0.05) << r.output;
   EXPECT_LT(std::abs(result["time_offset_s"].get<double>()), 0.01) << r.output;
@@ -597,6 +599,47 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
   const int updates = ExpectUpdateTimingMatches(result, csv, 30);
   EXPECT_LT(updates, 30);
   EXPECT_GT(updates, 10);
+}
+
+// Issue 5's fifth-frame criterion (≤ 0.3°) from ±2° (seeds 1-4): the refinement's rotation is
+// taken in place of the score map's best when it scores within 10 % of it (the map's peak sits a
+// few tenths of a degree from the refinement's optimum on these frames). Measured at the fifth
+// frame: 0.14, 0.71, 0.47 and 0.26° with the default; 0.29, 0.71, 0.47 and 0.50° with the
+// tolerance at 0 (the best score wins, as before). Over 16 starts of 1-3°: 10 of 16 within 0.3°
+// (median 0.26°) against 3 of 16 (median 0.43°), none worse.
+TEST(Cli, KittiFifthFrameTakesTheRefinedRotationWithinTheScoreTolerance) {
+  STCALIB_REQUIRE_KITTI();
+  testing::ScopedTempDir tmp;
+  int within_default = 0, within_best_score = 0;
+  double sum_default = 0, sum_best_score = 0;
+  bool taken_once = false;
+  for (const int seed : {1, 2, 3, 4}) {
+    double error[2] = {0, 0};
+    for (const int k : {0, 1}) {
+      const std::string tolerance = k == 0 ? "0.1" : "0";
+      SCOPED_TRACE("seed " + std::to_string(seed) + ", tolerance " + tolerance);
+      const std::string out = tmp.path() + "/s" + std::to_string(seed) + "_" + tolerance;
+      const RunResult r =
+          CalibrateKitti(out, "--seed=" + std::to_string(seed) +
+                                  " --num_frames=5 --refined_score_tolerance=" + tolerance);
+      const std::string csv = testing::ReadFile(out + "/per_frame.csv");
+      error[k] = PerFrameNumber(csv, 4, "rotation_error_deg");
+      ASSERT_TRUE(std::isfinite(error[k])) << r.output;
+      const bool taken = csv.find("its rotation only: score") != std::string::npos;
+      if (k == 1) {
+        EXPECT_FALSE(taken);
+      }
+      taken_once = taken_once || taken;
+    }
+    EXPECT_LE(error[0], error[1] + 1e-9) << "seed " << seed;
+    within_default += error[0] <= 0.3;
+    within_best_score += error[1] <= 0.3;
+    sum_default += error[0];
+    sum_best_score += error[1];
+  }
+  EXPECT_TRUE(taken_once);
+  EXPECT_GT(within_default, within_best_score);
+  EXPECT_LT(sum_default, sum_best_score - 0.3);
 }
 
 // δ started 50 ms off and the δ scan switched off: the estimate ends on a side peak about 4°

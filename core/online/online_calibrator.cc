@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace stcalib {
 namespace {
@@ -35,6 +36,9 @@ Status OnlineCalibratorOptions::Validate() const {
   if (window_frames < 1) return Status::Error("online: window_frames must be >= 1");
   if (!(polish_forward_std_m >= 0)) {
     return Status::Error("online: polish_forward_std_m must be >= 0");
+  }
+  if (!(refined_score_tolerance >= 0 && refined_score_tolerance < 1)) {
+    return Status::Error("online: refined_score_tolerance must be in [0, 1)");
   }
   if (tracking_update_every < 1) {
     return Status::Error("online: tracking_update_every must be >= 1");
@@ -343,14 +347,41 @@ void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowSc
   report->after = state_;
   report->reason = "no candidate scored better: estimate kept";
   double best = long_scorer->Evaluate(state_, -1).score;
-  for (const Candidate& candidate : candidates) {
-    if (!WithinBounds(candidate.state, anchor_, search_options)) continue;
-    const double value = long_scorer->Evaluate(candidate.state, -1).score;
+  size_t chosen = candidates.size();
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    if (!WithinBounds(candidates[c].state, anchor_, search_options)) continue;
+    const double value = long_scorer->Evaluate(candidates[c].state, -1).score;
     if (value < best) continue;
     best = value;
-    report->after = candidate.state;
+    chosen = c;
+    report->after = candidates[c].state;
     report->accepted = true;
-    report->reason = candidate.name;
+    report->reason = candidates[c].name;
+  }
+  // The refinement's rotation in place of the best-scoring one when it scores close enough: the
+  // score map's peak can sit a few tenths of a degree from the refinement's optimum (the score
+  // finds the peak, the refinement where on it). The translation and δ stay the chosen ones':
+  // edges pin them down only to a few cm (the polish holds them as well), and the refinement's δ
+  // runs along its ridge with the forward translation.
+  const bool refined_offered = !candidates.empty() && report->refine.usable &&
+                               candidates.front().name.rfind("refined", 0) == 0;
+  if (options_.refined_score_tolerance > 0 && refined_offered && chosen != 0 &&
+      !(report->coarse_search && report->acquiring)) {
+    CalibrationState rotated = report->after;
+    rotated.T_camera_lidar.linear() = candidates.front().state.T_camera_lidar.linear();
+    const double value = WithinBounds(rotated, anchor_, search_options)
+                             ? long_scorer->Evaluate(rotated, -1).score
+                             : -std::numeric_limits<double>::infinity();
+    if (value >= best - options_.refined_score_tolerance * std::abs(best)) {
+      char share[112];
+      const double percent = best != 0 ? 100.0 * (value - best) / std::abs(best) : 0.0;
+      std::snprintf(share, sizeof(share), " (its rotation only: score %.1f %% %s the best%s)",
+                    std::abs(percent), percent >= 0 ? "over" : "under",
+                    percent >= 0 ? "" : ", within the tolerance");
+      report->after = rotated;
+      report->accepted = true;
+      report->reason = candidates.front().name + share;
+    }
   }
   // While tracking, move only part of the way (a first-order filter over frames): single windows
   // scatter, their average does not. A lost estimate jumps, in rotation only once acquired (and
