@@ -324,10 +324,13 @@ std::vector<OnlineCalibrator::Candidate> OnlineCalibrator::Candidates(
   auto add = [&](const CalibrationState& candidate, const std::string& name, bool hold) {
     candidates.push_back(
         {hold ? KeepObservableAxes(state_, candidate, report->refine.observable) : candidate,
-         hold ? name + held : name});
+         hold ? name + held : name, false});
   };
   const bool hold_search = report->refine.covariance_ok && !held.empty();
-  if (report->refine.usable) add(report->refine.state, "refined", true);
+  if (report->refine.usable) {
+    add(report->refine.state, "refined", true);
+    candidates.back().refined = true;
+  }
   add(report->search.state, "search", hold_search);
   if (options_.search_from_last_healthy && report->coarse_search && has_last_healthy_ &&
       RotationErrorDeg(last_healthy_.T_camera_lidar.linear(), state_.T_camera_lidar.linear()) >
@@ -361,12 +364,10 @@ void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowSc
   // The refinement's rotation in place of the best-scoring one when it scores close enough: the
   // score map's peak can sit a few tenths of a degree from the refinement's optimum (the score
   // finds the peak, the refinement where on it). The translation and δ stay the chosen ones':
-  // edges pin them down only to a few cm (the polish holds them as well), and the refinement's δ
-  // runs along its ridge with the forward translation.
-  const bool refined_offered = !candidates.empty() && report->refine.usable &&
-                               candidates.front().name.rfind("refined", 0) == 0;
-  if (options_.refined_score_tolerance > 0 && refined_offered && chosen != 0 &&
-      !(report->coarse_search && report->acquiring)) {
+  // edges pin the translation down only to a few cm (the polish holds its lateral and vertical
+  // axes too), and the refinement's δ runs along its ridge with the forward translation.
+  if (options_.refined_score_tolerance > 0 && !candidates.empty() && candidates.front().refined &&
+      chosen != 0 && !(report->coarse_search && report->acquiring)) {
     CalibrationState rotated = report->after;
     rotated.T_camera_lidar.linear() = candidates.front().state.T_camera_lidar.linear();
     const double value = WithinBounds(rotated, anchor_, search_options)

@@ -192,6 +192,7 @@ class OnlineCalibrator {
   struct Candidate {
     CalibrationState state;
     std::string name;
+    bool refined = false;  ///< the refinement's estimate (its held axes kept)
   };
 
   // The steps of AddFrame.
