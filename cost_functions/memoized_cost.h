@@ -54,19 +54,18 @@ class MemoizedCostFunction final : public ceres::CostFunction {
     ++calls_;
     if (!hit) {
       ++evaluations_;
-      std::vector<double*>& into = into_;
-      std::fill(into.begin(), into.end(), nullptr);
+      std::fill(into_.begin(), into_.end(), nullptr);
       for (size_t b = 0; jacobians != nullptr && b < sizes.size(); ++b) {
         if (jacobians[b] == nullptr) continue;
         jacobians_[b].resize(rows * static_cast<size_t>(sizes[b]));
-        into[b] = jacobians_[b].data();
+        into_[b] = jacobians_[b].data();
       }
       valid_ = cost_->Evaluate(parameters, residuals_.data(),
-                               jacobians != nullptr ? into.data() : nullptr);
+                               jacobians != nullptr ? into_.data() : nullptr);
       if (!valid_) return false;
       for (size_t b = 0, offset = 0; b < sizes.size(); offset += sizes[b], ++b) {
         std::copy(parameters[b], parameters[b] + sizes[b], parameters_.begin() + offset);
-        have_jacobian_[b] = into[b] != nullptr;
+        have_jacobian_[b] = into_[b] != nullptr;
       }
     }
     std::copy(residuals_.begin(), residuals_.end(), residuals);

@@ -321,23 +321,21 @@ std::vector<OnlineCalibrator::Candidate> OnlineCalibrator::Candidates(
     if (!report->refine.observable[k]) held += std::string(", held ") + kAxisNames[k];
   }
   std::vector<Candidate> candidates;
-  auto add = [&](const CalibrationState& candidate, const std::string& name, bool hold) {
+  auto add = [&](const CalibrationState& candidate, const std::string& name, bool hold,
+                 bool refined) {
     candidates.push_back(
         {hold ? KeepObservableAxes(state_, candidate, report->refine.observable) : candidate,
-         hold ? name + held : name, false});
+         hold ? name + held : name, refined});
   };
   const bool hold_search = report->refine.covariance_ok && !held.empty();
-  if (report->refine.usable) {
-    add(report->refine.state, "refined", true);
-    candidates.back().refined = true;
-  }
-  add(report->search.state, "search", hold_search);
+  if (report->refine.usable) add(report->refine.state, "refined", true, true);
+  add(report->search.state, "search", hold_search, false);
   if (options_.search_from_last_healthy && report->coarse_search && has_last_healthy_ &&
       RotationErrorDeg(last_healthy_.T_camera_lidar.linear(), state_.T_camera_lidar.linear()) >
           options_.search.alpha3_rotation_deg) {
     const SearchResult again = AdaptiveGridSearch(scorer, last_healthy_, anchor_, search_options);
     report->search.evaluations += again.evaluations;
-    add(again.state, "search from the last healthy estimate", hold_search);
+    add(again.state, "search from the last healthy estimate", hold_search, false);
   }
   return candidates;
 }
