@@ -36,6 +36,8 @@ struct CalibrateOutcome {
   CalibrationError error, initial_error;
   std::vector<FrameReport> reports;
   FrameReport polish;  ///< the final refinement (OnlineCalibrator::Polish), if run
+  bool time_offset_estimated = true;  ///< δ was estimated (else held at δ0)
+  TimeForwardPair time_forward;       ///< δ against the forward translation (the verdict's)
   std::vector<std::string> pictures;
   double mean_frame_ms = 0;
 };

@@ -277,6 +277,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   outcome->converged = verdict.converged;
   outcome->reason = verdict.reason;
   outcome->alias_suspect = verdict.time_offset_profile.alias_suspect;
+  outcome->time_offset_estimated = job.online.refine.estimate_time_offset;
+  outcome->time_forward = verdict.time_forward;
   auto verdict_code = [&]() {
     if (outcome->converged) return kExitOk;
     std::fprintf(stderr, "stcalib calibrate: %s\n", outcome->reason.c_str());
@@ -311,9 +313,12 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const FrameReport& final_report = outcome->polish.accepted ? outcome->polish : *final_report_ptr;
   const int skipped = verdict.skipped_frames;
   const std::vector<std::string>& unobservable = verdict.unobservable_axes;
-  // The covariance is the refinement the verdict read (what the polish did with the forward
-  // translation and δ is in polish.reason).
+  // The covariance is the refinement the verdict read, except δ's: there the tracking
+  // refinement's std is conditional on the forward translation's prior, so δ is reported from the
+  // polish's solve with both free, and observable only when that solve separated the two and the
+  // polished estimate was kept.
   const RefineResult& refine = verdict.refine;
+  const TimeForwardPair& pair = verdict.time_forward;
 
   // Outputs.
   const std::string out = job.out_dir;
@@ -334,6 +339,22 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
         refine.covariance_ok ? nlohmann::json(refine.std_dev[k]) : nlohmann::json(nullptr);
     observable_json[kAxisNames[k]] = refine.observable[k];
   }
+  constexpr int kTime = kNumAxes - 1;
+  if (pair.measured) std_json[kAxisNames[kTime]] = pair.time_offset_std_s;
+  observable_json[kAxisNames[kTime]] = refine.observable[kTime] && pair.separated;
+  auto measured_or_null = [&](double value) {
+    return pair.measured ? nlohmann::json(value) : nlohmann::json(nullptr);
+  };
+  const nlohmann::json time_forward_json = {
+      {"rests_on", !job.online.refine.estimate_time_offset ? "start"
+                   : pair.separated                        ? "window"
+                                                           : "forward_translation_prior"},
+      {"measured", pair.measured},
+      {"time_offset_std_s", measured_or_null(pair.time_offset_std_s)},
+      {"forward_std_m", measured_or_null(pair.forward_std_m)},
+      {"correlation", measured_or_null(pair.correlation)},
+      {"time_offset_std_given_forward_prior_s",
+       refine.covariance_ok ? nlohmann::json(refine.std_dev[kTime]) : nlohmann::json(nullptr)}};
   const Eigen::Vector3d rpy_deg = MountRollPitchYawDeg(outcome->estimate.T_camera_lidar.linear());
   // Per frame, over all frames (those without an update count as 0 ms), and per update.
   double search_ms = 0, refine_ms = 0, update_ms = 0;
@@ -362,7 +383,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"time_offset_peak_s", profile.best_s},
       {"alias_second_peak_s", profile.second_peak_s},
       {"alias_second_peak_ratio", profile.second_peak_ratio},
-      {"time_forward_correlation", refine.time_forward_correlation},
+      {"time_forward_correlation",
+       pair.measured ? pair.correlation : refine.time_forward_correlation},
+      {"time_offset_vs_forward", time_forward_json},
       {"score", final_report.score_after.score},
       {"gray_rate", final_report.gray_rate_after},
       {"health", final_report.health},
@@ -488,6 +511,17 @@ int RunCalibrate() {
       outcome.has_truth ? "error vs ground truth" : "agreement with the drive calibration",
       e.rotation_deg, e.roll_deg, e.pitch_deg, e.yaw_deg, e.translation_norm_m,
       1000 * e.time_offset_s, 1000 * outcome.estimate.time_offset_s);
+  const TimeForwardPair& pair = outcome.time_forward;
+  if (outcome.time_offset_estimated && !pair.separated) {
+    std::printf(
+        "time offset: not separated from the forward translation in this drive, so it rests on "
+        "that translation's prior (time offset error = forward error / speed)");
+    if (pair.measured) {
+      std::printf("; with both free: std %.1f ms and %.1f cm, correlation %+.2f",
+                  1000 * pair.time_offset_std_s, 100 * pair.forward_std_m, pair.correlation);
+    }
+    std::printf("\n");
+  }
   if (!FLAGS_out.empty()) {
     std::printf("mean %.1f ms per frame; outputs in %s\n", outcome.mean_frame_ms,
                 FLAGS_out.c_str());

@@ -538,6 +538,17 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     EXPECT_THAT(polish.reason, ::testing::HasSubstr("forward translation and δ held"));
     EXPECT_TRUE(polish.refine.covariance_ok);  // rotation only: translation and δ held
     for (int k = 3; k < kNumAxes; ++k) EXPECT_FALSE(polish.refine.observable[k]) << kAxisNames[k];
+    // The pair was measured with both free, and not separated (measured: forward std 4.8 cm, δ
+    // std 4.7 ms, correlation -0.99); that δ std covers the held δ's error (-3.8 ms).
+    const TimeForwardPair& pair = polish.time_forward;
+    std::printf("polish pair: δ std %.2f ms, forward std %.2f cm, correlation %+.2f\n",
+                1000 * pair.time_offset_std_s, 100 * pair.forward_std_m, pair.correlation);
+    EXPECT_TRUE(pair.measured);
+    EXPECT_FALSE(pair.separated);
+    EXPECT_GT(pair.forward_std_m, online_options.polish_forward_std_m);
+    EXPECT_LT(pair.correlation, -0.9);
+    EXPECT_LE(std::abs(ComputeCalibrationError(calibrator.state(), truth).time_offset_s),
+              3 * pair.time_offset_std_s);
     EXPECT_TRUE(polish.refine.observable[0] && polish.refine.observable[1] &&
                 polish.refine.observable[2]);
     polished.push_back(calibrator.state());

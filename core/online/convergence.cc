@@ -185,12 +185,18 @@ ConvergenceVerdict JudgeAndPolish(OnlineCalibrator* calibrator,
     return verdict;
   }
   *polish = calibrator->Polish();
+  verdict.time_forward = polish->time_forward;
+  verdict.time_forward.separated = false;  // unless the polished estimate is kept
   if (!polish->accepted) return verdict;
   ConvergenceVerdict polished = JudgeConvergence(*calibrator, reports, initial, online, options);
-  if (polished.converged) return polished;
+  if (polished.converged) {
+    polished.time_forward = polish->time_forward;
+    return polished;
+  }
   calibrator->SetState(polish->before);
   polish->after = polish->before;
   polish->accepted = false;
+  polish->time_forward.separated = false;
   polish->reason += "; undone, the polished estimate did not converge (" + polished.reason + ")";
   return verdict;
 }

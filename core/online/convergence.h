@@ -57,6 +57,9 @@ struct ConvergenceVerdict {
   // The refinement the verdict read the axes' observability from: the last update's (refused
   // frames and tracking frames between updates run none), with its per-axis std and correlations.
   RefineResult refine;
+  // δ against the forward translation, from the polish (JudgeAndPolish; not measured without
+  // one): `separated` only when the polished estimate was kept.
+  TimeForwardPair time_forward;
 };
 
 // `reports` are all of the run's frame reports in order; `initial` the run's start.

@@ -202,6 +202,12 @@ FrameReport OnlineCalibrator::Polish() {
     report.refine = Refine(frames, state_, state_, anchor_, refine_options);
   }
   report.refine_ms = MillisecondsSince(start);
+  report.time_forward.measured = pair.covariance_ok && options_.refine.estimate_time_offset;
+  if (report.time_forward.measured) {
+    report.time_forward.time_offset_std_s = pair.std_dev[6];
+    report.time_forward.forward_std_m = pair.forward_std_m;
+    report.time_forward.correlation = pair.time_forward_correlation;
+  }
   if (!report.refine.usable) {
     report.reason = "polish: refinement failed (" + report.refine.message + ")";
     return report;
@@ -216,6 +222,7 @@ FrameReport OnlineCalibrator::Polish() {
   }
   report.after = state_ = polished;
   report.accepted = true;
+  report.time_forward.separated = report.time_forward.measured && pair_observable;
   char pair_text[160] = "";
   if (pair.covariance_ok) {
     std::snprintf(pair_text, sizeof(pair_text),
