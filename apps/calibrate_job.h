@@ -35,7 +35,7 @@ struct CalibrateOutcome {
   CalibrationState reference_state, initial, estimate;
   CalibrationError error, initial_error;
   std::vector<FrameReport> reports;
-  FrameReport polish;  ///< the final refinement (OnlineCalibrator::Polish), if run
+  FrameReport polish;                 ///< the final refinement (OnlineCalibrator::Polish), if run
   bool time_offset_estimated = true;  ///< δ was estimated (else held at δ0)
   TimeForwardPair time_forward;       ///< δ against the forward translation (the verdict's)
   std::vector<std::string> pictures;

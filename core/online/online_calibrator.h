@@ -109,11 +109,11 @@ struct OnlineCalibratorOptions {
 // only as right as the start's forward translation (δ error = forward error ÷ speed), however
 // small its std (KITTI: 0.45 ms held, 3.8 ms with the forward translation free).
 struct TimeForwardPair {
-  bool measured = false;          ///< the solve estimated δ and gave a covariance
-  bool separated = false;         ///< both observable, and the pair moved with the window's data
-  double time_offset_std_s = 0;   ///< δ's std with the forward translation free [s]
-  double forward_std_m = 0;       ///< the forward translation's std [m]
-  double correlation = 0;         ///< of δ with the forward translation
+  bool measured = false;         ///< the solve estimated δ and gave a covariance
+  bool separated = false;        ///< both observable, and the pair moved with the window's data
+  double time_offset_std_s = 0;  ///< δ's std with the forward translation free [s]
+  double forward_std_m = 0;      ///< the forward translation's std [m]
+  double correlation = 0;        ///< of δ with the forward translation
 };
 
 struct FrameReport {
