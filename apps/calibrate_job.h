@@ -43,6 +43,9 @@ struct CalibrateOutcome {
 };
 
 CalibrateJob CalibrateJobFromFlags();
+// One line (with its newline) saying that δ rests on the forward translation's prior, with the
+// pair's std and correlation when measured; empty when δ was separated or not estimated.
+std::string TimeOffsetPriorNote(const CalibrateOutcome& outcome);
 // Runs the job and writes its outputs; returns the exit code (0 only when converged).
 int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome);
 

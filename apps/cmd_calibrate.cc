@@ -148,6 +148,22 @@ CalibrateJob CalibrateJobFromFlags() {
   return job;
 }
 
+std::string TimeOffsetPriorNote(const CalibrateOutcome& outcome) {
+  const TimeForwardPair& pair = outcome.time_forward;
+  if (!outcome.time_offset_estimated || pair.separated) return "";
+  std::string note =
+      "time offset: not separated from the forward translation in this drive, so it rests on "
+      "that translation's prior (time offset error = forward error / speed)";
+  if (pair.measured) {
+    char numbers[128];
+    std::snprintf(numbers, sizeof(numbers),
+                  "; with both free: std %.1f ms and %.1f cm, correlation %+.2f",
+                  1000 * pair.time_offset_std_s, 100 * pair.forward_std_m, pair.correlation);
+    note += numbers;
+  }
+  return note + "\n";
+}
+
 int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const char* kCommand = "calibrate";
   Status status = job.online.Validate();
@@ -511,17 +527,7 @@ int RunCalibrate() {
       outcome.has_truth ? "error vs ground truth" : "agreement with the drive calibration",
       e.rotation_deg, e.roll_deg, e.pitch_deg, e.yaw_deg, e.translation_norm_m,
       1000 * e.time_offset_s, 1000 * outcome.estimate.time_offset_s);
-  const TimeForwardPair& pair = outcome.time_forward;
-  if (outcome.time_offset_estimated && !pair.separated) {
-    std::printf(
-        "time offset: not separated from the forward translation in this drive, so it rests on "
-        "that translation's prior (time offset error = forward error / speed)");
-    if (pair.measured) {
-      std::printf("; with both free: std %.1f ms and %.1f cm, correlation %+.2f",
-                  1000 * pair.time_offset_std_s, 100 * pair.forward_std_m, pair.correlation);
-    }
-    std::printf("\n");
-  }
+  std::printf("%s", TimeOffsetPriorNote(outcome).c_str());
   if (!FLAGS_out.empty()) {
     std::printf("mean %.1f ms per frame; outputs in %s\n", outcome.mean_frame_ms,
                 FLAGS_out.c_str());

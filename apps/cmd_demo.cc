@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <random>
+#include <string>
 
 #include "apps/calibrate_job.h"
 #include "apps/commands.h"
@@ -66,9 +67,10 @@ int RunDemo() {
   row("estimate", outcome.error, 1000 * outcome.estimate.time_offset_s);
   std::printf("  (time offset column: the value itself; its error is %+.2f ms)\n",
               1000 * outcome.error.time_offset_s);
-  std::printf("\n%s (%s); %.0f ms per frame; %.1f s in all\n",
-              outcome.converged ? "converged" : "NOT converged", outcome.reason.c_str(),
-              outcome.mean_frame_ms,
+  std::printf("%s", TimeOffsetPriorNote(outcome).c_str());
+  // A verdict other than success gives its reason ("not converged: ...").
+  const std::string verdict = outcome.converged ? "converged" : outcome.reason;
+  std::printf("\n%s; %.0f ms per frame; %.1f s in all\n", verdict.c_str(), outcome.mean_frame_ms,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   std::printf("pictures:\n");
   for (const std::string& p : outcome.pictures) std::printf("  %s\n", p.c_str());
