@@ -43,6 +43,9 @@ struct CalibrateOutcome {
 };
 
 CalibrateJob CalibrateJobFromFlags();
+// What δ rests on: "window" (the polish separated it from the forward translation),
+// "forward_translation_prior" (it did not, or did not run), "start" (δ not estimated).
+std::string TimeOffsetRestsOn(const CalibrateOutcome& outcome);
 // One line (with its newline) saying that δ rests on the forward translation's prior, with the
 // pair's std and correlation when measured; empty when δ was separated or not estimated.
 std::string TimeOffsetPriorNote(const CalibrateOutcome& outcome);

@@ -148,20 +148,26 @@ CalibrateJob CalibrateJobFromFlags() {
   return job;
 }
 
+std::string TimeOffsetRestsOn(const CalibrateOutcome& outcome) {
+  if (!outcome.time_offset_estimated) return "start";
+  return outcome.time_forward.separated ? "window" : "forward_translation_prior";
+}
+
 std::string TimeOffsetPriorNote(const CalibrateOutcome& outcome) {
+  if (TimeOffsetRestsOn(outcome) != "forward_translation_prior") return "";
   const TimeForwardPair& pair = outcome.time_forward;
-  if (!outcome.time_offset_estimated || pair.separated) return "";
-  std::string note =
-      "time offset: not separated from the forward translation in this drive, so it rests on "
-      "that translation's prior (time offset error = forward error / speed)";
-  if (pair.measured) {
-    char numbers[128];
-    std::snprintf(numbers, sizeof(numbers),
-                  "; with both free: std %.1f ms and %.1f cm, correlation %+.2f",
-                  1000 * pair.time_offset_std_s, 100 * pair.forward_std_m, pair.correlation);
-    note += numbers;
+  if (!pair.measured) {
+    return "time offset: estimated with the forward translation held (the polish, which frees "
+           "both, did not measure them), so it rests on that translation's prior (time offset "
+           "error = forward error / speed)\n";
   }
-  return note + "\n";
+  char numbers[128];
+  std::snprintf(numbers, sizeof(numbers),
+                "; with both free: std %.1f ms and %.1f cm, correlation %+.2f",
+                1000 * pair.time_offset_std_s, 100 * pair.forward_std_m, pair.correlation);
+  return "time offset: not separated from the forward translation in this drive, so it rests on "
+         "that translation's prior (time offset error = forward error / speed)" +
+         std::string(numbers) + "\n";
 }
 
 int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
@@ -355,22 +361,27 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
         refine.covariance_ok ? nlohmann::json(refine.std_dev[k]) : nlohmann::json(nullptr);
     observable_json[kAxisNames[k]] = refine.observable[k];
   }
+  // δ's std is the one with the forward translation free; without that solve there is none to
+  // give (the tracking std, conditional on the forward prior, is reported beside it).
   constexpr int kTime = kNumAxes - 1;
-  if (pair.measured) std_json[kAxisNames[kTime]] = pair.time_offset_std_s;
+  const bool time_estimated = outcome->time_offset_estimated;
+  if (time_estimated) {
+    std_json[kAxisNames[kTime]] =
+        pair.measured ? nlohmann::json(pair.time_offset_std_s) : nlohmann::json(nullptr);
+  }
   observable_json[kAxisNames[kTime]] = refine.observable[kTime] && pair.separated;
   auto measured_or_null = [&](double value) {
     return pair.measured ? nlohmann::json(value) : nlohmann::json(nullptr);
   };
   const nlohmann::json time_forward_json = {
-      {"rests_on", !job.online.refine.estimate_time_offset ? "start"
-                   : pair.separated                        ? "window"
-                                                           : "forward_translation_prior"},
+      {"rests_on", TimeOffsetRestsOn(*outcome)},
       {"measured", pair.measured},
       {"time_offset_std_s", measured_or_null(pair.time_offset_std_s)},
       {"forward_std_m", measured_or_null(pair.forward_std_m)},
       {"correlation", measured_or_null(pair.correlation)},
-      {"time_offset_std_given_forward_prior_s",
-       refine.covariance_ok ? nlohmann::json(refine.std_dev[kTime]) : nlohmann::json(nullptr)}};
+      {"time_offset_std_given_forward_prior_s", refine.covariance_ok && time_estimated
+                                                    ? nlohmann::json(refine.std_dev[kTime])
+                                                    : nlohmann::json(nullptr)}};
   const Eigen::Vector3d rpy_deg = MountRollPitchYawDeg(outcome->estimate.T_camera_lidar.linear());
   // Per frame, over all frames (those without an update count as 0 ms), and per update.
   double search_ms = 0, refine_ms = 0, update_ms = 0;

@@ -180,6 +180,15 @@ TEST(Cli, CalibrateFromAStartSoWrongNothingProjects) {
   EXPECT_THAT(r.output, HasSubstr("not converged"));
   EXPECT_FALSE(std::filesystem::exists(out + "/calib_velo_to_cam.txt"));
   EXPECT_THAT(testing::ReadFile(out + "/result.json"), HasSubstr("\"converged\": false"));
+  // No polish ran, so δ was never freed from the forward translation: no std is claimed for it,
+  // it is not observable, and the printout says the pair was not measured.
+  const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
+  EXPECT_FALSE(result["polish"]["applied"].get<bool>());
+  EXPECT_EQ(result["time_offset_vs_forward"]["rests_on"], "forward_translation_prior");
+  EXPECT_FALSE(result["time_offset_vs_forward"]["measured"].get<bool>());
+  EXPECT_TRUE(result["std"]["time_offset_s"].is_null()) << result["std"];
+  EXPECT_FALSE(result["observable"]["time_offset_s"].get<bool>());
+  EXPECT_THAT(r.output, HasSubstr("the polish, which frees both, did not measure them"));
 }
 
 TEST(Cli, CheckHoldsForKittiCalibrationAndCatchesOneDegreeOff) {

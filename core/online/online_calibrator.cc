@@ -202,7 +202,8 @@ FrameReport OnlineCalibrator::Polish() {
     report.refine = Refine(frames, state_, state_, anchor_, refine_options);
   }
   report.refine_ms = MillisecondsSince(start);
-  report.time_forward.measured = pair.covariance_ok && options_.refine.estimate_time_offset;
+  report.time_forward.measured =
+      pair.usable && pair.covariance_ok && options_.refine.estimate_time_offset;
   if (report.time_forward.measured) {
     report.time_forward.time_offset_std_s = pair.std_dev[6];
     report.time_forward.forward_std_m = pair.forward_std_m;
