@@ -156,18 +156,19 @@ std::string TimeOffsetRestsOn(const CalibrateOutcome& outcome) {
 std::string TimeOffsetPriorNote(const CalibrateOutcome& outcome) {
   if (TimeOffsetRestsOn(outcome) != "forward_translation_prior") return "";
   const TimeForwardPair& pair = outcome.time_forward;
+  const std::string consequence =
+      "so it rests on that translation's prior (time offset error = forward error / speed)";
   if (!pair.measured) {
     return "time offset: estimated with the forward translation held (the polish, which frees "
-           "both, did not measure them), so it rests on that translation's prior (time offset "
-           "error = forward error / speed)\n";
+           "both, did not measure them), " +
+           consequence + "\n";
   }
   char numbers[128];
   std::snprintf(numbers, sizeof(numbers),
                 "; with both free: std %.1f ms and %.1f cm, correlation %+.2f",
                 1000 * pair.time_offset_std_s, 100 * pair.forward_std_m, pair.correlation);
-  return "time offset: not separated from the forward translation in this drive, so it rests on "
-         "that translation's prior (time offset error = forward error / speed)" +
-         std::string(numbers) + "\n";
+  return "time offset: not separated from the forward translation in this drive, " + consequence +
+         numbers + "\n";
 }
 
 int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {

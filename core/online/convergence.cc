@@ -185,19 +185,21 @@ ConvergenceVerdict JudgeAndPolish(OnlineCalibrator* calibrator,
     return verdict;
   }
   *polish = calibrator->Polish();
-  verdict.time_forward = polish->time_forward;
-  verdict.time_forward.separated = false;  // unless the polished estimate is kept
-  if (!polish->accepted) return verdict;
-  ConvergenceVerdict polished = JudgeConvergence(*calibrator, reports, initial, online, options);
-  if (polished.converged) {
-    polished.time_forward = polish->time_forward;
-    return polished;
+  if (polish->accepted) {
+    ConvergenceVerdict polished = JudgeConvergence(*calibrator, reports, initial, online, options);
+    if (polished.converged) {
+      verdict = polished;
+    } else {
+      calibrator->SetState(polish->before);
+      polish->after = polish->before;
+      polish->accepted = false;
+      polish->time_forward.separated = false;  // the pair did not move after all
+      polish->reason +=
+          "; undone, the polished estimate did not converge (" + polished.reason + ")";
+    }
   }
-  calibrator->SetState(polish->before);
-  polish->after = polish->before;
-  polish->accepted = false;
-  polish->time_forward.separated = false;
-  polish->reason += "; undone, the polished estimate did not converge (" + polished.reason + ")";
+  // Polish() marks the pair separated only when it applied the pair's move.
+  verdict.time_forward = polish->time_forward;
   return verdict;
 }
 
