@@ -339,7 +339,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   // The covariance is the refinement the verdict read, except δ's: there the tracking
   // refinement's std is conditional on the forward translation's prior, so δ is reported from the
   // polish's solve with both free, and observable only when that solve separated the two and the
-  // polished estimate was kept.
+  // polished estimate was kept (verdict.time_offset_observable).
   const RefineResult& refine = verdict.refine;
   const TimeForwardPair& pair = verdict.time_forward;
 
@@ -370,7 +370,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     std_json[kAxisNames[kTime]] =
         pair.measured ? nlohmann::json(pair.time_offset_std_s) : nlohmann::json(nullptr);
   }
-  observable_json[kAxisNames[kTime]] = refine.observable[kTime] && pair.separated;
+  observable_json[kAxisNames[kTime]] = verdict.time_offset_observable;
   auto measured_or_null = [&](double value) {
     return pair.measured ? nlohmann::json(value) : nlohmann::json(nullptr);
   };

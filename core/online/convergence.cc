@@ -200,6 +200,8 @@ ConvergenceVerdict JudgeAndPolish(OnlineCalibrator* calibrator,
   }
   // Polish() marks the pair separated only when it applied the pair's move.
   verdict.time_forward = polish->time_forward;
+  verdict.time_offset_observable = online.refine.estimate_time_offset &&
+                                   verdict.refine.observable[6] && verdict.time_forward.separated;
   return verdict;
 }
 
