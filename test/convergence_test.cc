@@ -1,5 +1,6 @@
-// Convergence verdict (core/online/convergence.h): the independent check on texture-suppressed
-// maps refuses a KITTI estimate 3° off that the plain maps' rules would have accepted.
+// Convergence verdict (core/online/convergence.h): a polish that does not converge refuses the
+// claim; the independent check on texture-suppressed maps refuses a KITTI estimate 3° off that
+// the plain maps' rules would have accepted.
 #include "core/online/convergence.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +13,39 @@
 
 namespace stcalib {
 namespace {
+
+// After a polish: the polished verdict when it converged; a converged online estimate whose
+// polish does not converge is refused, with the polish's reason; a refusal stays one.
+TEST(Convergence, PolishThatDoesNotConvergeRefusesTheClaim) {
+  ConvergenceVerdict online;
+  online.converged = true;
+  online.reason = "converged";
+  online.estimate.time_offset_s = 0.01;
+  ConvergenceVerdict polished;
+  polished.converged = false;
+  polished.reason = "not converged: the last frames' score peaks +0.50 deg away on roll_deg";
+  polished.estimate.time_offset_s = 0.02;
+
+  const ConvergenceVerdict refused = VerdictAfterPolish(online, polished);
+  EXPECT_FALSE(refused.converged);
+  EXPECT_EQ(refused.reason,
+            "not converged: refined over its last frames, the estimate does not converge (the "
+            "last frames' score peaks +0.50 deg away on roll_deg)");
+  EXPECT_EQ(refused.estimate.time_offset_s, 0.01);  // the online estimate, not the polished one
+
+  polished.converged = true;
+  polished.reason = "converged";
+  const ConvergenceVerdict taken = VerdictAfterPolish(online, polished);
+  EXPECT_TRUE(taken.converged);
+  EXPECT_EQ(taken.estimate.time_offset_s, 0.02);
+
+  online.converged = false;
+  online.reason = "not converged: still moving (0.400 deg over the last 3 frames)";
+  polished.converged = false;
+  const ConvergenceVerdict kept = VerdictAfterPolish(online, polished);
+  EXPECT_FALSE(kept.converged);
+  EXPECT_EQ(kept.reason, online.reason);
+}
 
 TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
   STCALIB_REQUIRE_KITTI();

@@ -76,11 +76,19 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                                     const OnlineCalibratorOptions& online,
                                     const ConvergenceOptions& options);
 
+// The verdict after a polish: `polished` (the polished estimate's) when it converged; else the
+// online one, refused when it had converged: an estimate whose refinement over its own frames
+// ends where the rules refuse is no stable optimum of those frames.
+ConvergenceVerdict VerdictAfterPolish(const ConvergenceVerdict& online,
+                                      const ConvergenceVerdict& polished);
+
 // The verdict on the online estimate and, when it converged, on its polish
 // (OnlineCalibrator::Polish): the polished estimate is kept only when it converges too, else the
 // calibrator goes back to the online estimate and `polish` says why. A polish can refine a
 // converged estimate, never turn a refusal into a claim (a wrong peak can be refined onto the
-// score's peak, as on a street of poles). `polish` may be null: no polish.
+// score's peak, as on a street of poles). A polished estimate that does not converge turns the
+// claim into a refusal: the estimate is then no stable optimum of its frames. `polish` may be
+// null: no polish.
 ConvergenceVerdict JudgeAndPolish(OnlineCalibrator* calibrator,
                                   const std::vector<FrameReport>& reports,
                                   const CalibrationState& initial,
