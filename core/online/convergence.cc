@@ -216,10 +216,9 @@ ConvergenceVerdict JudgeAndPolish(OnlineCalibrator* calibrator,
     }
     verdict = VerdictAfterPolish(verdict, polished);
   }
-  // Polish() marks the pair separated only when it applied the pair's move.
+  // Polish() marks the pair separated only when it estimated δ and applied the pair's move.
   verdict.time_forward = polish->time_forward;
-  verdict.time_offset_observable = online.refine.estimate_time_offset &&
-                                   verdict.refine.observable[6] && verdict.time_forward.separated;
+  verdict.time_offset_observable = verdict.refine.observable[6] && verdict.time_forward.separated;
   return verdict;
 }
 
