@@ -109,6 +109,7 @@ CalibrateJob CalibrateJobFromFlags() {
   o.lost_grid_step_deg = FLAGS_lost_grid_step_deg;
   o.acquire_time_offset = FLAGS_acquire_time_offset;
   o.point_margin = FLAGS_point_margin;
+  ParseFolds(FLAGS_lidar_folds, &o.folds);
   o.horizontal_weight = FLAGS_horizontal_weight;
   o.search.alpha1_rotation_deg = FLAGS_alpha1_rotation_deg;
   o.search.alpha2_translation_m = FLAGS_alpha2_translation_m;
@@ -526,6 +527,10 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
 int RunCalibrate() {
   if (FLAGS_loss != "cauchy" && FLAGS_loss != "huber") {
     return UsageError("calibrate", "--loss must be cauchy or huber");
+  }
+  OnlineCalibratorOptions::Folds folds;
+  if (!ParseFolds(FLAGS_lidar_folds, &folds)) {
+    return UsageError("calibrate", "--lidar_folds must be keep, drop or drop_when_tracking");
   }
   CalibrateOutcome outcome;
   const int code = RunCalibrateJob(CalibrateJobFromFlags(), &outcome);

@@ -71,3 +71,4 @@ DECLARE_double(lost_grid_step_deg);
 DECLARE_bool(acquire_time_offset);
 DECLARE_bool(bandpass_score);
 DECLARE_double(point_margin);
+DECLARE_string(lidar_folds);

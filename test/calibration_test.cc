@@ -106,6 +106,32 @@ TEST(OnlineCalibrator, RefusesBadFramesAndKeepsTheEstimate) {
   EXPECT_EQ(calibrator.state().time_offset_s, start.time_offset_s);
 }
 
+// WithoutFolds drops the fold points with their kinds and rates; a frame without folds is
+// returned as it is.
+TEST(OnlineCalibrator, WithoutFoldsDropsFoldsWithTheirEntries) {
+  auto frame = BareFrame(0, 1.0);
+  for (int i = 0; i < 4; ++i) {
+    frame->points_lidar.push_back(Eigen::Vector3d(i, 0, 5));
+    frame->kinds.push_back(i % 2 ? EdgeKind::kHorizontal : EdgeKind::kVertical);
+    frame->offset_rates.push_back(Eigen::Vector3d(0, 0, i));
+  }
+  std::shared_ptr<const CalibrationFrame> none = frame;
+  EXPECT_EQ(WithoutFolds(none).get(), none.get());  // no fold flags at all
+  frame->folds = {0, 0, 0, 0};
+  EXPECT_EQ(WithoutFolds(none).get(), none.get());  // flags, none set
+  frame->folds = {0, 1, 0, 0};
+  const auto kept = WithoutFolds(std::make_shared<const CalibrationFrame>(*frame));
+  ASSERT_EQ(kept->size(), 3u);
+  EXPECT_THAT(kept->folds, ::testing::ElementsAre(0, 0, 0));
+  for (size_t k = 0; k < 3; ++k) {
+    const double i = kept->points_lidar[k].x();  // the original index
+    EXPECT_NE(i, 1.0);
+    EXPECT_EQ(kept->offset_rates[k].z(), i);
+    EXPECT_EQ(kept->kinds[k],
+              static_cast<int>(i) % 2 ? EdgeKind::kHorizontal : EdgeKind::kVertical);
+  }
+}
+
 // The shared settings reach every stage: the calibrator scores and refines with its one
 // horizontal-edge weight and its one δ bound, whatever the sub-structs held.
 TEST(OnlineCalibrator, SharedSettingsReachScoreSearchAndRefine) {
@@ -370,12 +396,37 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   // full refinement window, which needs a drive longer than these 12 frames at the default 20.
   OnlineCalibratorOptions online_options;
   online_options.refine_frames = 10;
-  OnlineCalibrator calibrator(online_options, Step(truth, Eigen::Vector3d(-2, 2, -2) * M_PI / 180.0,
-                                                   Eigen::Vector3d(0.05, -0.05, 0.05), -0.03));
+  const CalibrationState online_start = Step(truth, Eigen::Vector3d(-2, 2, -2) * M_PI / 180.0,
+                                             Eigen::Vector3d(0.05, -0.05, 0.05), -0.03);
+  OnlineCalibrator calibrator(online_options, online_start);
+  // Alongside, the same run dropping the folds once acquired (Folds::kDropWhenTracking): until
+  // the acquisition's last frame it reads what the default reads and ends where it does; from
+  // the next frame on its windows hold no fold.
+  ASSERT_EQ(online_options.folds, OnlineCalibratorOptions::Folds::kKeep);
+  OnlineCalibratorOptions dropping_options = online_options;
+  dropping_options.folds = OnlineCalibratorOptions::Folds::kDropWhenTracking;
+  OnlineCalibrator dropping(dropping_options, online_start);
+  auto folds_read = [](const OnlineCalibrator& c) {
+    size_t folds = 0;
+    for (const auto& f : c.RecentFrames()) folds += std::count(f->folds.begin(), f->folds.end(), 1);
+    return folds;
+  };
+  size_t folds_while_acquiring = 0;
   FrameReport last;
   for (size_t k = 0; k < frames.size(); ++k) {
     const CalibrationState before = calibrator.state();
     last = calibrator.AddFrame(frames[k]);
+    const FrameReport dropped = dropping.AddFrame(frames[k]);
+    if (dropped.acquiring) {  // acquiring when the frame arrived: the default's frames
+      folds_while_acquiring += folds_read(dropping);
+      EXPECT_EQ(folds_read(dropping), folds_read(calibrator)) << "frame " << k;
+      EXPECT_TRUE(dropping.state().T_camera_lidar.matrix() ==
+                  calibrator.state().T_camera_lidar.matrix())
+          << "frame " << k;
+    } else {
+      EXPECT_EQ(folds_read(dropping), 0u) << "frame " << k;
+      EXPECT_GT(folds_read(calibrator), 0u) << "frame " << k;
+    }
     if (static_cast<int>(k) + 1 < online_options.window_frames) {
       // One or two frames are not trusted with a jump: the window fills first.
       EXPECT_FALSE(last.accepted);
@@ -393,10 +444,21 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
               calibrator.grid_cache().frames_scored(), uncached_bound);
   EXPECT_GT(calibrator.grid_cache().frames_scored(), 0);
   EXPECT_LT(calibrator.grid_cache().frames_scored(), uncached_bound);
+  EXPECT_GT(folds_while_acquiring, 0u);
+  {
+    auto later = std::make_shared<CalibrationFrame>(*frames.back());  // a tracking frame
+    later->camera_time_s += 20.0;
+    ASSERT_GT(std::count(later->folds.begin(), later->folds.end(), 1), 0);
+    ASSERT_FALSE(dropping.acquiring());
+    dropping.AddFrame(later);
+    EXPECT_EQ(folds_read(dropping), 0u);
+    EXPECT_LT(ComputeCalibrationError(dropping.state(), truth).rotation_deg, 0.5);
+  }
   const CalibrationError online_error = ComputeCalibrationError(calibrator.state(), truth);
   std::printf("online after %zu frames: %s, health %.2f\n", frames.size(),
               ToString(online_error).c_str(), last.health);
-  EXPECT_LT(online_error.rotation_deg, 0.5);  // measured 0.22° (from 3.46°; plain IDT 0.45°)
+  EXPECT_LT(online_error.rotation_deg,
+            0.5);  // measured 0.22° (from 3.46°; plain IDT 0.45°)
   EXPECT_LT(online_error.translation_norm_m, 0.12);
   EXPECT_LT(std::abs(online_error.time_offset_s), 0.02);
   EXPECT_GT(last.health, 0.8);
@@ -576,6 +638,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   empty->points_lidar.clear();
   empty->kinds.clear();
   empty->offset_rates.clear();
+  empty->folds.clear();
   OnlineCalibratorOptions single;
   single.window_frames = 1;
   single.refine_frames = 1;

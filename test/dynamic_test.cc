@@ -329,6 +329,7 @@ TEST(LocalMap, EarlierSweepsArePlacedAtTheTimeOffsetToFirstOrder) {
     edges->kind.push_back(EdgeKind::kVertical);
     edges->source_index.push_back(7);
     edges->offset_rate.push_back(Eigen::Vector3d::Zero());
+    edges->fold.push_back(0);
   }
   const Rigid3d T = RelativeLidarPose(motion, 2.0, 1.8);
   Eigen::Matrix<double, 3, 4> rate = RelativeLidarPoseRate(motion, 2.0, 1.8);

@@ -398,6 +398,70 @@ TEST(LidarEdges, SimulatedEdgePointsLieOnTrueGeometricEdges) {
   EXPECT_GE(static_cast<double>(near_edge) / total, 0.80);
 }
 
+// Folds (LidarEdgeOptions) against the simulator's scene. Within a few metres of depth a fold is
+// an object's own corner, not its outline: the beam above it, cast at the same capture time,
+// meets the same object as the fold's own return (its top, or a face behind the corner on that
+// object: a car's cabin behind its bonnet). Unbounded (the default), the folds also take outlines
+// whose beam above meets a background at their height.
+TEST(LidarEdges, FoldsAreCornersOfTheirOwnObject) {
+  size_t folds = 0, same_object = 0, horizontal = 0, unbounded = 0;
+  LidarFeatureOptions corners;
+  corners.edges.fold_max_depth_m = 3.0;
+  for (uint64_t seed : {3u, 8u}) {
+    SimulatorOptions options;
+    options.seed = seed;
+    options.frames = 20;
+    const Simulator s(options);
+    for (int frame : {4, 15}) {
+      const sim::SimulatedSweep sweep = s.SimulateSweep(frame);
+      const LidarFrameFeatures f = ComputeLidarFrameFeatures(
+          sweep.scan, s.LidarMidTime(frame), s.SweepDuration(), TruthPose(s), {}, corners);
+      ASSERT_EQ(f.edges.fold.size(), f.edges.size());
+      const LidarFrameFeatures all_folds =
+          ComputeLidarFrameFeatures(sweep.scan, s.LidarMidTime(frame), s.SweepDuration(),
+                                    TruthPose(s), {}, LidarFeatureOptions());
+      ASSERT_EQ(all_folds.edges.size(), f.edges.size());  // the same edges, more of them folds
+      for (size_t k = 0; k < f.edges.size(); ++k) {
+        ASSERT_TRUE(!f.edges.fold[k] || all_folds.edges.fold[k]);
+        unbounded += all_folds.edges.fold[k];
+      }
+      const double t_mid = s.LidarMidTime(frame);
+      const sim::AzimuthIndex index = s.scene().BuildIndex(
+          TruthPose(s)(t_mid).translation().head<2>(), t_mid - 0.06, t_mid + 0.06, 1.5, 130);
+      for (size_t k = 0; k < f.edges.size(); ++k) {
+        horizontal += f.edges.kind[k] == EdgeKind::kHorizontal;
+        if (!f.edges.fold[k]) continue;
+        ++folds;
+        ASSERT_EQ(f.edges.kind[k], EdgeKind::kHorizontal);
+        const int i = f.edges.source_index[k];
+        const int rank = f.rings.elevation_rank[f.rings.ring[i]] - 1;  // the beam above
+        ASSERT_GE(rank, 0);
+        const double elevation = f.rings.ring_elevation_rad[f.rings.order_by_elevation[rank]];
+        const double azimuth = f.rings.azimuth_rad[i];
+        const Eigen::Vector3d up_lidar(std::cos(elevation) * std::cos(azimuth),
+                                       std::cos(elevation) * std::sin(azimuth),
+                                       std::sin(elevation));
+        const double t = sweep.point_time_s[i];
+        const Rigid3d T = TruthPose(s)(t);
+        sim::RayHit own, above;
+        const bool hit_own =
+            s.scene().Intersect(index, T.translation(),
+                                T.linear() * sweep.scan.points_lidar[i].normalized(), t, 130, &own);
+        const bool hit_above =
+            s.scene().Intersect(index, T.translation(), T.linear() * up_lidar, t, 130, &above);
+        same_object += hit_own && hit_above && own.object >= 0 && above.object == own.object;
+      }
+    }
+  }
+  std::printf(
+      "%zu folds within 3 m among %zu horizontal edge points, %zu on their own object; %zu "
+      "unbounded\n",
+      folds, horizontal, same_object, unbounded);
+  ASSERT_GT(folds, 20u);
+  EXPECT_GT(unbounded, folds);
+  EXPECT_GE(static_cast<double>(same_object) / folds, 0.9);
+}
+
 TEST(Ground, PlaneSeparatesSimulatedGroundLabels) {
   SimulatorOptions options;
   options.seed = 5;

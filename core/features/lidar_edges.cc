@@ -60,6 +60,7 @@ LidarEdges KeepRuns(const LidarEdges &edges, const ScanRings &rings,
     kept.kind.push_back(edges.kind[k]);
     kept.source_index.push_back(edges.source_index[k]);
     kept.offset_rate.push_back(edges.offset_rate[k]);
+    kept.fold.push_back(edges.fold[k]);
   }
   return kept;
 }
@@ -69,6 +70,9 @@ LidarEdges KeepRuns(const LidarEdges &edges, const ScanRings &rings,
 Status LidarEdgeOptions::Validate() const {
   if (!(min_range_m >= 0 && max_range_m > min_range_m)) {
     return Status::Error("lidar edges: need 0 <= min_range_m < max_range_m");
+  }
+  if (!(fold_height_tolerance_m >= 0) || !(fold_max_depth_m >= 0)) {
+    return Status::Error("lidar edges: fold_height_tolerance_m and fold_max_depth_m must be >= 0");
   }
   if (!(jump_min_m > 0) || jump_per_range < 0 || !(smooth_tolerance_m > 0) ||
       smooth_per_range < 0 || smooth_neighbours < 0 || !(max_gap_steps >= 1)) {
@@ -83,6 +87,8 @@ void LidarEdges::Append(const LidarEdges &other) {
   kind.insert(kind.end(), other.kind.begin(), other.kind.end());
   source_index.insert(source_index.end(), other.source_index.begin(), other.source_index.end());
   offset_rate.insert(offset_rate.end(), other.offset_rate.begin(), other.offset_rate.end());
+  CHECK_EQ(other.fold.size(), other.size()) << "LidarEdges::fold: one entry per point";
+  fold.insert(fold.end(), other.fold.begin(), other.fold.end());
 }
 
 LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
@@ -109,7 +115,7 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
   // half-step bias of taking the near return itself. `far_direction` is the far
   // neighbour's direction, or the direction of the missing return (sky) it would
   // have had; zero when unknown.
-  auto add = [&](int i, EdgeKind kind, const Eigen::Vector3d &far_direction) {
+  auto add = [&](int i, EdgeKind kind, const Eigen::Vector3d &far_direction, bool fold) {
     if (is_edge[i]) return;
     is_edge[i] = 1;
     Eigen::Vector3d p = scan.points_lidar[i];
@@ -122,6 +128,7 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
     edges.kind.push_back(kind);
     edges.source_index.push_back(i);
     edges.offset_rate.push_back(Eigen::Vector3d::Zero());
+    edges.fold.push_back(fold ? 1 : 0);
   };
 
   // Vertical edges: along each ring, returns in azimuth order.
@@ -172,7 +179,7 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
             far_direction =
                 Eigen::AngleAxisd(dir * step, Eigen::Vector3d::UnitZ()) * scan.points_lidar[i];
           }
-          add(i, EdgeKind::kVertical, far_direction);
+          add(i, EdgeKind::kVertical, far_direction, false);
           break;
         }
       }
@@ -231,7 +238,12 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
                                   std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
             }
           }
-          add(static_cast<int>(i), EdgeKind::kHorizontal, far_direction);
+          // The beam above (dir −1 in elevation order) on the same height, below the sensor.
+          const double z = scan.points_lidar[i].z();
+          const bool fold =
+              dir < 0 && far >= 0 && z < 0 && other - r < options.fold_max_depth_m &&
+              std::abs(scan.points_lidar[far].z() - z) < options.fold_height_tolerance_m;
+          add(static_cast<int>(i), EdgeKind::kHorizontal, far_direction, fold);
           break;
         }
       }

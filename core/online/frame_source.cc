@@ -106,6 +106,7 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   out->points_lidar = std::move(map.points_lidar);
   out->kinds = std::move(map.kind);
   out->offset_rates = std::move(map.offset_rate);
+  out->folds = std::move(map.fold);
 
   const double lidar_s = motion_.Seconds(drive_->lidar_stamps_ns[frame]);
   out->e0_s = lidar_s - camera_s;

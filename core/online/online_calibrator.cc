@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 
 namespace stcalib {
 namespace {
@@ -50,6 +51,31 @@ Status OnlineCalibratorOptions::Validate() const {
   return refine.Validate();
 }
 
+namespace {
+constexpr std::pair<OnlineCalibratorOptions::Folds, const char*> kFoldsNames[] = {
+    {OnlineCalibratorOptions::Folds::kKeep, "keep"},
+    {OnlineCalibratorOptions::Folds::kDrop, "drop"},
+    {OnlineCalibratorOptions::Folds::kDropWhenTracking, "drop_when_tracking"}};
+}  // namespace
+
+const char* FoldsName(OnlineCalibratorOptions::Folds folds) {
+  for (const auto& [value, name] : kFoldsNames) {
+    if (value == folds) return name;
+  }
+  LOG(FATAL) << "unknown OnlineCalibratorOptions::Folds " << static_cast<int>(folds);
+  return "";
+}
+
+bool ParseFolds(const std::string& name, OnlineCalibratorOptions::Folds* folds) {
+  for (const auto& [value, text] : kFoldsNames) {
+    if (name == text) {
+      *folds = value;
+      return true;
+    }
+  }
+  return false;
+}
+
 OnlineCalibratorOptions WithSharedSettings(const OnlineCalibratorOptions& options) {
   OnlineCalibratorOptions out = options;
   out.search.time_offset_bound_s = options.time_offset_bound_s;
@@ -69,10 +95,23 @@ OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
   frames_since_update_ = options_.tracking_update_every;
 }
 
+const CalibrationFrame* OnlineCalibrator::InUse(const WindowFrame& frame) const {
+  const bool drop = options_.folds == OnlineCalibratorOptions::Folds::kDrop || folds_dropped_;
+  return drop ? frame.without_folds.get() : frame.all.get();
+}
+
 std::vector<const CalibrationFrame*> OnlineCalibrator::SearchWindow() const {
   std::vector<const CalibrationFrame*> frames;
   const size_t n = std::min<size_t>(window_.size(), options_.window_frames);
-  for (size_t k = window_.size() - n; k < window_.size(); ++k) frames.push_back(window_[k].get());
+  for (size_t k = window_.size() - n; k < window_.size(); ++k) frames.push_back(InUse(window_[k]));
+  return frames;
+}
+
+std::vector<std::shared_ptr<const CalibrationFrame>> OnlineCalibrator::RecentFrames() const {
+  std::vector<std::shared_ptr<const CalibrationFrame>> frames;
+  for (const WindowFrame& frame : window_) {
+    frames.push_back(InUse(frame) == frame.all.get() ? frame.all : frame.without_folds);
+  }
   return frames;
 }
 
@@ -90,7 +129,9 @@ FrameReport OnlineCalibrator::SkipFrame(int frame, const std::string& why) const
 std::vector<const CalibrationFrame*> OnlineCalibrator::RefineWindow() const {
   std::vector<const CalibrationFrame*> frames;
   const size_t n = std::min<size_t>(window_.size(), options_.refine_frames);
-  for (size_t k = window_.size() - n; k < window_.size(); ++k) frames.push_back(window_[k].get());
+  for (size_t k = window_.size() - n; k < window_.size(); ++k) {
+    frames.push_back(InUse(window_[k]));
+  }
   return frames;
 }
 
@@ -113,11 +154,19 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   const std::string why = RefusalReason(*frame);
   if (!why.empty()) return SkipFrame(frame->index, why);
   last_camera_time_s_ = frame->camera_time_s;
+  // From the first frame after the acquisition (its last update and a polish right after it read
+  // the frames the estimate was acquired on).
+  if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && !acquiring()) {
+    folds_dropped_ = true;
+  }
   FrameReport report;
   report.frame = frame->index;
   report.acquiring = acquiring();
   report.before = report.after = state_;
-  window_.push_back(PruneToImage(*frame, state_, options_.point_margin));
+  WindowFrame in_window;
+  in_window.all = PruneToImage(*frame, state_, options_.point_margin);
+  in_window.without_folds = WithoutFolds(in_window.all);
+  window_.push_back(std::move(in_window));
   while (static_cast<int>(window_.size()) >
          std::max(options_.window_frames, options_.refine_frames)) {
     window_.pop_front();

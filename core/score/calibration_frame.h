@@ -24,6 +24,8 @@ struct CalibrationFrame {
   std::vector<EdgeKind> kinds;
   // ∂p/∂δ [m/s] (LidarEdges::offset_rate), read by the refinement; empty: all zero.
   std::vector<Eigen::Vector3d> offset_rates;
+  // 1: the point is a fold (LidarEdges::fold); empty: none is.
+  std::vector<uint8_t> folds;
   ImageFeatures image;  ///< distance_raw_px for overlays
   // Maps per edge kind, indexed by EdgeKind (0 vertical, 1 horizontal): with oriented maps a
   // vertical LiDAR edge reads the map of near-vertical image edges only; otherwise both entries

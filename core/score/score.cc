@@ -292,27 +292,47 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
   return values;
 }
 
+namespace {
+
+// `frame` with the points for which `keep(i)` holds, their per-point entries kept with them.
+template <typename Keep>
+std::shared_ptr<const CalibrationFrame> KeepPoints(const CalibrationFrame& frame, Keep keep) {
+  CHECK(frame.offset_rates.empty() || frame.offset_rates.size() == frame.size());
+  CHECK(frame.folds.empty() || frame.folds.size() == frame.size());
+  auto kept = std::make_shared<CalibrationFrame>(frame);
+  kept->points_lidar.clear();
+  kept->kinds.clear();
+  kept->offset_rates.clear();
+  kept->folds.clear();
+  for (size_t i = 0; i < frame.size(); ++i) {
+    if (!keep(i)) continue;
+    kept->points_lidar.push_back(frame.points_lidar[i]);
+    kept->kinds.push_back(frame.kinds[i]);
+    if (!frame.offset_rates.empty()) kept->offset_rates.push_back(frame.offset_rates[i]);
+    if (!frame.folds.empty()) kept->folds.push_back(frame.folds[i]);
+  }
+  return kept;
+}
+
+}  // namespace
+
 std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& frame,
                                                      const CalibrationState& state, double margin) {
-  CHECK(frame.offset_rates.empty() || frame.offset_rates.size() == frame.size());
-  auto pruned = std::make_shared<CalibrationFrame>(frame);
-  pruned->points_lidar.clear();
-  pruned->kinds.clear();
-  pruned->offset_rates.clear();
   const double mu = margin * frame.camera.width;
   const double mv = margin * frame.camera.height;
-  for (size_t i = 0; i < frame.size(); ++i) {
+  return KeepPoints(frame, [&](size_t i) {
     Eigen::Vector2d pixel;
-    if (!ProjectFramePoint(frame, state, i, &pixel)) continue;
-    if (pixel.x() < mu || pixel.y() < mv || pixel.x() > frame.camera.width - mu ||
-        pixel.y() > frame.camera.height - mv) {
-      continue;
-    }
-    pruned->points_lidar.push_back(frame.points_lidar[i]);
-    pruned->kinds.push_back(frame.kinds[i]);
-    if (!frame.offset_rates.empty()) pruned->offset_rates.push_back(frame.offset_rates[i]);
-  }
-  return pruned;
+    if (!ProjectFramePoint(frame, state, i, &pixel)) return false;
+    return pixel.x() >= mu && pixel.y() >= mv && pixel.x() <= frame.camera.width - mu &&
+           pixel.y() <= frame.camera.height - mv;
+  });
+}
+
+std::shared_ptr<const CalibrationFrame> WithoutFolds(
+    std::shared_ptr<const CalibrationFrame> frame) {
+  CHECK(frame != nullptr);
+  if (std::find(frame->folds.begin(), frame->folds.end(), 1) == frame->folds.end()) return frame;
+  return KeepPoints(*frame, [&](size_t i) { return frame->folds[i] == 0; });
 }
 
 bool HealthSetting::operator==(const HealthSetting& o) const {

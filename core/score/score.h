@@ -91,6 +91,8 @@ CalibrationState Step(const CalibrationState& state, const Eigen::Vector3d& rota
 // over all points would reward calibrations that pull outside points into the image.
 std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& frame,
                                                      const CalibrationState& state, double margin);
+// The frame without its folds (CalibrationFrame::folds): the same frame when it has none.
+std::shared_ptr<const CalibrationFrame> WithoutFolds(std::shared_ptr<const CalibrationFrame> frame);
 
 // What the health score's per-frame scores depend on besides the frame. With a
 // HealthScoreCache, an online calibrator whose estimate did not move since the last frame scores
