@@ -162,6 +162,10 @@ TEST(Cli, CalibrateWithoutFeaturesFailsAndClaimsNothing) {
   text << result.rdbuf();
   EXPECT_THAT(text.str(), HasSubstr("\"converged\": false"));
   EXPECT_EQ(RunStcalib("calibrate --drive=" + drive + " --out=" + out + " --loss=l3").exit_code, 2);
+  const RunResult folds =
+      RunStcalib("calibrate --drive=" + drive + " --out=" + out + " --lidar_folds=sometimes");
+  EXPECT_EQ(folds.exit_code, 2);
+  EXPECT_THAT(folds.output, HasSubstr("--lidar_folds must be keep, drop or drop_when_tracking"));
   // Without --out (optional, method.md §9) the verdict and exit code are the same.
   const RunResult no_out = RunStcalib("calibrate --drive=" + drive);
   EXPECT_EQ(no_out.exit_code, 1) << no_out.output;
