@@ -524,14 +524,18 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   return verdict_code();
 }
 
-int RunCalibrate() {
-  if (FLAGS_loss != "cauchy" && FLAGS_loss != "huber") {
-    return UsageError("calibrate", "--loss must be cauchy or huber");
-  }
+std::string CalibrateFlagsError() {
+  if (FLAGS_loss != "cauchy" && FLAGS_loss != "huber") return "--loss must be cauchy or huber";
   OnlineCalibratorOptions::Folds folds;
   if (!ParseFolds(FLAGS_lidar_folds, &folds)) {
-    return UsageError("calibrate", "--lidar_folds must be keep, drop or drop_when_tracking");
+    return "--lidar_folds must be keep, drop or drop_when_tracking";
   }
+  return "";
+}
+
+int RunCalibrate() {
+  const std::string flags_error = CalibrateFlagsError();
+  if (!flags_error.empty()) return UsageError("calibrate", flags_error);
   CalibrateOutcome outcome;
   const int code = RunCalibrateJob(CalibrateJobFromFlags(), &outcome);
   if (outcome.reports.empty()) return code;

@@ -17,6 +17,8 @@ namespace stcalib::cli {
 
 int RunDemo() {
   namespace fs = std::filesystem;
+  const std::string flags_error = CalibrateFlagsError();
+  if (!flags_error.empty()) return UsageError("demo", flags_error);
   const auto start = std::chrono::steady_clock::now();
   std::error_code ec;
   const std::string root =

@@ -134,9 +134,12 @@ DEFINE_bool(acquire_time_offset, kOnline.acquire_time_offset,
             "calibrate: while acquiring, scan δ over its whole bound after the rotation grid");
 DEFINE_bool(bandpass_score, kSource.bandpass_score,
             "calibrate: with --suppress_texture, score on the band-pass IDT (not clipped at 0)");
-DEFINE_string(lidar_folds, stcalib::FoldsName(kOnline.folds),
-              "calibrate: LiDAR edge folds (a horizontal top's front corner seen from above): keep "
-              "| drop | drop_when_tracking (read only until the estimate is acquired)");
+DEFINE_string(
+    lidar_folds, stcalib::FoldsName(kOnline.folds),
+    "calibrate: LiDAR horizontal edges below the sensor whose beam above returns at their "
+    "own height (a top's front corner seen from above, or its outline against a "
+    "background at that height): keep | drop | drop_when_tracking (dropped from the "
+    "first frame after the acquisition)");
 DEFINE_double(point_margin, kOnline.point_margin,
               "calibrate: LiDAR edge points are kept when they project inside the image shrunk by "
               "this share of its size (negative: grown) at the estimate when their frame arrives");

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <tuple>
 
 #include "core/online/frame_source.h"
 #include "core/online/online_calibrator.h"
@@ -106,30 +107,67 @@ TEST(OnlineCalibrator, RefusesBadFramesAndKeepsTheEstimate) {
   EXPECT_EQ(calibrator.state().time_offset_s, start.time_offset_s);
 }
 
-// WithoutFolds drops the fold points with their kinds and rates; a frame without folds is
-// returned as it is.
-TEST(OnlineCalibrator, WithoutFoldsDropsFoldsWithTheirEntries) {
-  auto frame = BareFrame(0, 1.0);
+// BareFrame with four edge points 5 m ahead that project into its image at the identity
+// calibration, the second one a fold; point i lies at x = 0.1 i.
+std::shared_ptr<CalibrationFrame> FrameWithAFold(int index, double time_s) {
+  auto frame = BareFrame(index, time_s);
+  frame->camera.P_rect_02 << 10, 0, 32, 0, 0, 10, 16, 0, 0, 0, 1, 0;
   for (int i = 0; i < 4; ++i) {
-    frame->points_lidar.push_back(Eigen::Vector3d(i, 0, 5));
+    frame->points_lidar.push_back(Eigen::Vector3d(0.1 * i, 0, 5));
     frame->kinds.push_back(i % 2 ? EdgeKind::kHorizontal : EdgeKind::kVertical);
     frame->offset_rates.push_back(Eigen::Vector3d(0, 0, i));
   }
-  std::shared_ptr<const CalibrationFrame> none = frame;
-  EXPECT_EQ(WithoutFolds(none).get(), none.get());  // no fold flags at all
-  frame->folds = {0, 0, 0, 0};
-  EXPECT_EQ(WithoutFolds(none).get(), none.get());  // flags, none set
   frame->folds = {0, 1, 0, 0};
-  const auto kept = WithoutFolds(std::make_shared<const CalibrationFrame>(*frame));
+  return frame;
+}
+
+// WithoutFolds drops the fold points with their kinds and rates, in order; a frame without
+// folds is returned as it is.
+TEST(OnlineCalibrator, WithoutFoldsDropsFoldsWithTheirEntries) {
+  auto frame = FrameWithAFold(0, 1.0);
+  const auto kept = WithoutFolds(std::shared_ptr<const CalibrationFrame>(frame));
   ASSERT_EQ(kept->size(), 3u);
   EXPECT_THAT(kept->folds, ::testing::ElementsAre(0, 0, 0));
+  std::vector<int> index;
   for (size_t k = 0; k < 3; ++k) {
-    const double i = kept->points_lidar[k].x();  // the original index
-    EXPECT_NE(i, 1.0);
+    const int i = static_cast<int>(std::lround(10 * kept->points_lidar[k].x()));
+    index.push_back(i);
     EXPECT_EQ(kept->offset_rates[k].z(), i);
-    EXPECT_EQ(kept->kinds[k],
-              static_cast<int>(i) % 2 ? EdgeKind::kHorizontal : EdgeKind::kVertical);
+    EXPECT_EQ(kept->kinds[k], i % 2 ? EdgeKind::kHorizontal : EdgeKind::kVertical);
   }
+  EXPECT_THAT(index, ::testing::ElementsAre(0, 2, 3));
+  std::shared_ptr<const CalibrationFrame> none = frame;
+  frame->folds = {0, 0, 0, 0};
+  EXPECT_EQ(WithoutFolds(none).get(), none.get());
+  frame->folds.clear();  // no flags at all
+  EXPECT_EQ(WithoutFolds(none).get(), none.get());
+}
+
+// What the calibrator's window holds of a frame with a fold: kKeep all four points, kDrop three;
+// kDropWhenTracking four as long as it acquires, and also without the grid's acquisition (there
+// is none to end).
+TEST(OnlineCalibrator, FoldsInTheWindowFollowTheOption) {
+  using Folds = OnlineCalibratorOptions::Folds;
+  for (const auto& [folds, grid_deg, points] :
+       {std::tuple{Folds::kKeep, 3.0, 4u}, std::tuple{Folds::kDrop, 3.0, 3u},
+        std::tuple{Folds::kDropWhenTracking, 3.0, 4u},
+        std::tuple{Folds::kDropWhenTracking, 0.0, 4u}}) {
+    OnlineCalibratorOptions options;
+    options.folds = folds;
+    options.lost_grid_deg = grid_deg;
+    OnlineCalibrator calibrator(options, CalibrationState());
+    const FrameReport r = calibrator.AddFrame(FrameWithAFold(0, 1.0));
+    EXPECT_NE(r.reason.find("too few LiDAR edge points"), std::string::npos) << r.reason;
+    ASSERT_EQ(calibrator.RecentFrames().size(), 1u);
+    EXPECT_EQ(calibrator.RecentFrames()[0]->size(), points)
+        << FoldsName(folds) << ", grid " << grid_deg;
+    EXPECT_EQ(calibrator.SearchWindow()[0], calibrator.RecentFrames()[0].get());
+  }
+  OnlineCalibratorOptions::Folds parsed = OnlineCalibratorOptions::Folds::kKeep;
+  EXPECT_TRUE(ParseFolds("drop_when_tracking", &parsed));
+  EXPECT_EQ(parsed, OnlineCalibratorOptions::Folds::kDropWhenTracking);
+  EXPECT_FALSE(ParseFolds("sometimes", &parsed));
+  EXPECT_EQ(parsed, OnlineCalibratorOptions::Folds::kDropWhenTracking);
 }
 
 // The shared settings reach every stage: the calibrator scores and refines with its one
@@ -457,8 +495,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   const CalibrationError online_error = ComputeCalibrationError(calibrator.state(), truth);
   std::printf("online after %zu frames: %s, health %.2f\n", frames.size(),
               ToString(online_error).c_str(), last.health);
-  EXPECT_LT(online_error.rotation_deg,
-            0.5);  // measured 0.22° (from 3.46°; plain IDT 0.45°)
+  EXPECT_LT(online_error.rotation_deg, 0.5);  // measured 0.22° (from 3.46°; plain IDT 0.45°)
   EXPECT_LT(online_error.translation_norm_m, 0.12);
   EXPECT_LT(std::abs(online_error.time_offset_s), 0.02);
   EXPECT_GT(last.health, 0.8);

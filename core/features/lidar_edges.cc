@@ -82,12 +82,13 @@ Status LidarEdgeOptions::Validate() const {
 }
 
 void LidarEdges::Append(const LidarEdges &other) {
+  CHECK_EQ(fold.size(), size()) << "LidarEdges::fold: one entry per point";
+  CHECK_EQ(other.fold.size(), other.size()) << "LidarEdges::fold: one entry per point";
   points_lidar.insert(points_lidar.end(), other.points_lidar.begin(), other.points_lidar.end());
   time_s.insert(time_s.end(), other.time_s.begin(), other.time_s.end());
   kind.insert(kind.end(), other.kind.begin(), other.kind.end());
   source_index.insert(source_index.end(), other.source_index.begin(), other.source_index.end());
   offset_rate.insert(offset_rate.end(), other.offset_rate.begin(), other.offset_rate.end());
-  CHECK_EQ(other.fold.size(), other.size()) << "LidarEdges::fold: one entry per point";
   fold.insert(fold.end(), other.fold.begin(), other.fold.end());
 }
 

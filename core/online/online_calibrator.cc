@@ -95,23 +95,28 @@ OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
   frames_since_update_ = options_.tracking_update_every;
 }
 
-const CalibrationFrame* OnlineCalibrator::InUse(const WindowFrame& frame) const {
+const std::shared_ptr<const CalibrationFrame>& OnlineCalibrator::InUse(
+    const WindowFrame& frame) const {
   const bool drop = options_.folds == OnlineCalibratorOptions::Folds::kDrop || folds_dropped_;
-  return drop ? frame.without_folds.get() : frame.all.get();
+  return drop ? frame.without_folds : frame.all;
+}
+
+std::vector<const CalibrationFrame*> OnlineCalibrator::LatestFrames(int count) const {
+  std::vector<const CalibrationFrame*> frames;
+  const size_t n = std::min<size_t>(window_.size(), count);
+  for (size_t k = window_.size() - n; k < window_.size(); ++k) {
+    frames.push_back(InUse(window_[k]).get());
+  }
+  return frames;
 }
 
 std::vector<const CalibrationFrame*> OnlineCalibrator::SearchWindow() const {
-  std::vector<const CalibrationFrame*> frames;
-  const size_t n = std::min<size_t>(window_.size(), options_.window_frames);
-  for (size_t k = window_.size() - n; k < window_.size(); ++k) frames.push_back(InUse(window_[k]));
-  return frames;
+  return LatestFrames(options_.window_frames);
 }
 
 std::vector<std::shared_ptr<const CalibrationFrame>> OnlineCalibrator::RecentFrames() const {
   std::vector<std::shared_ptr<const CalibrationFrame>> frames;
-  for (const WindowFrame& frame : window_) {
-    frames.push_back(InUse(frame) == frame.all.get() ? frame.all : frame.without_folds);
-  }
+  for (const WindowFrame& frame : window_) frames.push_back(InUse(frame));
   return frames;
 }
 
@@ -127,12 +132,7 @@ FrameReport OnlineCalibrator::SkipFrame(int frame, const std::string& why) const
 }
 
 std::vector<const CalibrationFrame*> OnlineCalibrator::RefineWindow() const {
-  std::vector<const CalibrationFrame*> frames;
-  const size_t n = std::min<size_t>(window_.size(), options_.refine_frames);
-  for (size_t k = window_.size() - n; k < window_.size(); ++k) {
-    frames.push_back(InUse(window_[k]));
-  }
-  return frames;
+  return LatestFrames(options_.refine_frames);
 }
 
 std::string OnlineCalibrator::RefusalReason(const CalibrationFrame& frame) const {
@@ -155,8 +155,9 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   if (!why.empty()) return SkipFrame(frame->index, why);
   last_camera_time_s_ = frame->camera_time_s;
   // From the first frame after the acquisition (its last update and a polish right after it read
-  // the frames the estimate was acquired on).
-  if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && !acquiring()) {
+  // the frames the estimate was acquired on). Without the grid's acquisition there is none to
+  // end, and the folds stay. Once dropped they stay out, of a lost estimate's grid too.
+  if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && !acquiring_) {
     folds_dropped_ = true;
   }
   FrameReport report;
@@ -165,7 +166,9 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   report.before = report.after = state_;
   WindowFrame in_window;
   in_window.all = PruneToImage(*frame, state_, options_.point_margin);
-  in_window.without_folds = WithoutFolds(in_window.all);
+  in_window.without_folds = options_.folds == OnlineCalibratorOptions::Folds::kKeep
+                                ? in_window.all
+                                : WithoutFolds(in_window.all);
   window_.push_back(std::move(in_window));
   while (static_cast<int>(window_.size()) >
          std::max(options_.window_frames, options_.refine_frames)) {

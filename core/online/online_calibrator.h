@@ -109,6 +109,9 @@ struct OnlineCalibratorOptions {
   //    rotation on fold-free frames into that bias: 0.35° from the truth, 0.14° with kKeep. Not the
   //    default.
   //  - kDrop: KITTI's fifth frame within 0.3° on 4 of 16, and one start claimed 0.52° and 8 cm.
+  // kDropWhenTracking without the grid's acquisition (acquire_with_grid off, lost_grid_deg 0)
+  // keeps them: there is no acquisition to end. Once dropped, they stay out of every later
+  // window, a lost estimate's grid and search included.
   enum class Folds { kKeep, kDrop, kDropWhenTracking };
   Folds folds = Folds::kKeep;
 
@@ -218,7 +221,9 @@ class OnlineCalibrator {
   }
   // The latest window_frames frames (what a search on the latest frame reads).
   std::vector<const CalibrationFrame*> SearchWindow() const;
-  // The latest refine_frames frames (what a refinement on the latest frame reads), oldest first.
+  // Every frame the calibrator keeps (the latest max(window_frames, refine_frames), what a
+  // refinement on the latest frame reads among them), oldest first, as it reads them now
+  // (OnlineCalibratorOptions::folds).
   std::vector<std::shared_ptr<const CalibrationFrame>> RecentFrames() const;
 
  private:
@@ -267,12 +272,14 @@ class OnlineCalibrator {
   // Tracking frames since the last search and refinement (starts due: the first updates).
   int frames_since_update_ = 0;
   CalibrationState last_healthy_;
-  // A frame of the window: all its points (pruned to the image) and the same without its folds.
+  // A frame of the window: all its points (pruned to the image) and the same without its folds
+  // (the same frame with Folds::kKeep).
   struct WindowFrame {
     std::shared_ptr<const CalibrationFrame> all, without_folds;
   };
   // The version of `frame` the calibrator reads now (OnlineCalibratorOptions::folds).
-  const CalibrationFrame* InUse(const WindowFrame& frame) const;
+  const std::shared_ptr<const CalibrationFrame>& InUse(const WindowFrame& frame) const;
+  std::vector<const CalibrationFrame*> LatestFrames(int count) const;  ///< as read now
   std::deque<WindowFrame> window_;  // the last refine_frames frames
   // The rotation grid's per-frame scores: while acquiring the grid runs on a window that grows
   // by one frame, and each frame is scored once as long as the translation and δ stay put.

@@ -323,8 +323,8 @@ std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& fra
   return KeepPoints(frame, [&](size_t i) {
     Eigen::Vector2d pixel;
     if (!ProjectFramePoint(frame, state, i, &pixel)) return false;
-    return pixel.x() >= mu && pixel.y() >= mv && pixel.x() <= frame.camera.width - mu &&
-           pixel.y() <= frame.camera.height - mv;
+    return !(pixel.x() < mu || pixel.y() < mv || pixel.x() > frame.camera.width - mu ||
+             pixel.y() > frame.camera.height - mv);
   });
 }
 
