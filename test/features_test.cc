@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <opencv2/imgproc.hpp>
 
 #include "core/features/ground.h"
@@ -363,38 +364,43 @@ bool NearTrueEdge(const Simulator& s, const sim::AzimuthIndex& index, const Eige
   return false;
 }
 
-TEST(LidarEdges, SimulatedEdgePointsLieOnTrueGeometricEdges) {
-  size_t total = 0, near_edge = 0;
+// Calls `visit` on frames 4 and 15 of simulated 20-frame drives, seeds 3 and 8.
+void ForEachSimulatedSweep(
+    const std::function<void(const Simulator&, uint64_t, int, const sim::SimulatedSweep&)>& visit) {
   for (uint64_t seed : {3u, 8u}) {
     SimulatorOptions options;
     options.seed = seed;
     options.frames = 20;
     const Simulator s(options);
-    for (int frame : {4, 15}) {
-      const sim::SimulatedSweep sweep = s.SimulateSweep(frame);
-      const LidarFrameFeatures f =
-          ComputeLidarFrameFeatures(sweep.scan, s.LidarMidTime(frame), s.SweepDuration(),
-                                    TruthPose(s), {}, LidarFeatureOptions());
-      ASSERT_GT(f.edges.size(), 500u);
-      const double t_mid = s.LidarMidTime(frame);
-      const Rigid3d T_mid = TruthPose(s)(t_mid);
-      const sim::AzimuthIndex index =
-          s.scene().BuildIndex(T_mid.translation().head<2>(), t_mid - 0.06, t_mid + 0.06, 1.5, 130);
-      size_t frame_near = 0;
-      for (size_t k = 0; k < f.edges.size(); ++k) {
-        const int i = f.edges.source_index[k];
-        const double t = sweep.point_time_s[i];
-        const Rigid3d T = TruthPose(s)(t);
-        frame_near +=
-            NearTrueEdge(s, index, T.translation(), T * sweep.scan.points_lidar[i], t, 0.2);
-      }
-      std::printf("seed %llu frame %d: %zu edge points, %.1f%% within 0.2 m of a true edge\n",
-                  static_cast<unsigned long long>(seed), frame, f.edges.size(),
-                  100.0 * frame_near / f.edges.size());
-      total += f.edges.size();
-      near_edge += frame_near;
-    }
+    for (int frame : {4, 15}) visit(s, seed, frame, s.SimulateSweep(frame));
   }
+}
+
+TEST(LidarEdges, SimulatedEdgePointsLieOnTrueGeometricEdges) {
+  size_t total = 0, near_edge = 0;
+  ForEachSimulatedSweep([&](const Simulator& s, uint64_t seed, int frame,
+                            const sim::SimulatedSweep& sweep) {
+    const LidarFrameFeatures f =
+        ComputeLidarFrameFeatures(sweep.scan, s.LidarMidTime(frame), s.SweepDuration(),
+                                  TruthPose(s), {}, LidarFeatureOptions());
+    ASSERT_GT(f.edges.size(), 500u);
+    const double t_mid = s.LidarMidTime(frame);
+    const Rigid3d T_mid = TruthPose(s)(t_mid);
+    const sim::AzimuthIndex index =
+        s.scene().BuildIndex(T_mid.translation().head<2>(), t_mid - 0.06, t_mid + 0.06, 1.5, 130);
+    size_t frame_near = 0;
+    for (size_t k = 0; k < f.edges.size(); ++k) {
+      const int i = f.edges.source_index[k];
+      const double t = sweep.point_time_s[i];
+      const Rigid3d T = TruthPose(s)(t);
+      frame_near += NearTrueEdge(s, index, T.translation(), T * sweep.scan.points_lidar[i], t, 0.2);
+    }
+    std::printf("seed %llu frame %d: %zu edge points, %.1f%% within 0.2 m of a true edge\n",
+                static_cast<unsigned long long>(seed), frame, f.edges.size(),
+                100.0 * frame_near / f.edges.size());
+    total += f.edges.size();
+    near_edge += frame_near;
+  });
   EXPECT_GE(static_cast<double>(near_edge) / total, 0.80);
 }
 
@@ -407,52 +413,45 @@ TEST(LidarEdges, FoldsAreCornersOfTheirOwnObject) {
   size_t folds = 0, same_object = 0, horizontal = 0, unbounded = 0;
   LidarFeatureOptions corners;
   corners.edges.fold_max_depth_m = 3.0;
-  for (uint64_t seed : {3u, 8u}) {
-    SimulatorOptions options;
-    options.seed = seed;
-    options.frames = 20;
-    const Simulator s(options);
-    for (int frame : {4, 15}) {
-      const sim::SimulatedSweep sweep = s.SimulateSweep(frame);
-      const LidarFrameFeatures f = ComputeLidarFrameFeatures(
-          sweep.scan, s.LidarMidTime(frame), s.SweepDuration(), TruthPose(s), {}, corners);
-      ASSERT_EQ(f.edges.fold.size(), f.edges.size());
-      const LidarFrameFeatures all_folds =
-          ComputeLidarFrameFeatures(sweep.scan, s.LidarMidTime(frame), s.SweepDuration(),
-                                    TruthPose(s), {}, LidarFeatureOptions());
-      ASSERT_EQ(all_folds.edges.size(), f.edges.size());  // the same edges, more of them folds
-      for (size_t k = 0; k < f.edges.size(); ++k) {
-        ASSERT_TRUE(!f.edges.fold[k] || all_folds.edges.fold[k]);
-        unbounded += all_folds.edges.fold[k];
-      }
-      const double t_mid = s.LidarMidTime(frame);
-      const sim::AzimuthIndex index = s.scene().BuildIndex(
-          TruthPose(s)(t_mid).translation().head<2>(), t_mid - 0.06, t_mid + 0.06, 1.5, 130);
-      for (size_t k = 0; k < f.edges.size(); ++k) {
-        horizontal += f.edges.kind[k] == EdgeKind::kHorizontal;
-        if (!f.edges.fold[k]) continue;
-        ++folds;
-        ASSERT_EQ(f.edges.kind[k], EdgeKind::kHorizontal);
-        const int i = f.edges.source_index[k];
-        const int rank = f.rings.elevation_rank[f.rings.ring[i]] - 1;  // the beam above
-        ASSERT_GE(rank, 0);
-        const double elevation = f.rings.ring_elevation_rad[f.rings.order_by_elevation[rank]];
-        const double azimuth = f.rings.azimuth_rad[i];
-        const Eigen::Vector3d up_lidar(std::cos(elevation) * std::cos(azimuth),
-                                       std::cos(elevation) * std::sin(azimuth),
-                                       std::sin(elevation));
-        const double t = sweep.point_time_s[i];
-        const Rigid3d T = TruthPose(s)(t);
-        sim::RayHit own, above;
-        const bool hit_own =
-            s.scene().Intersect(index, T.translation(),
-                                T.linear() * sweep.scan.points_lidar[i].normalized(), t, 130, &own);
-        const bool hit_above =
-            s.scene().Intersect(index, T.translation(), T.linear() * up_lidar, t, 130, &above);
-        same_object += hit_own && hit_above && own.object >= 0 && above.object == own.object;
-      }
+  ForEachSimulatedSweep([&](const Simulator& s, uint64_t, int frame,
+                            const sim::SimulatedSweep& sweep) {
+    const LidarFrameFeatures f = ComputeLidarFrameFeatures(
+        sweep.scan, s.LidarMidTime(frame), s.SweepDuration(), TruthPose(s), {}, corners);
+    ASSERT_EQ(f.edges.fold.size(), f.edges.size());
+    const LidarFrameFeatures all_folds =
+        ComputeLidarFrameFeatures(sweep.scan, s.LidarMidTime(frame), s.SweepDuration(),
+                                  TruthPose(s), {}, LidarFeatureOptions());
+    ASSERT_EQ(all_folds.edges.size(), f.edges.size());  // the same edges, more of them folds
+    for (size_t k = 0; k < f.edges.size(); ++k) {
+      ASSERT_TRUE(!f.edges.fold[k] || all_folds.edges.fold[k]);
+      unbounded += all_folds.edges.fold[k];
     }
-  }
+    const double t_mid = s.LidarMidTime(frame);
+    const sim::AzimuthIndex index = s.scene().BuildIndex(
+        TruthPose(s)(t_mid).translation().head<2>(), t_mid - 0.06, t_mid + 0.06, 1.5, 130);
+    for (size_t k = 0; k < f.edges.size(); ++k) {
+      horizontal += f.edges.kind[k] == EdgeKind::kHorizontal;
+      if (!f.edges.fold[k]) continue;
+      ++folds;
+      ASSERT_EQ(f.edges.kind[k], EdgeKind::kHorizontal);
+      const int i = f.edges.source_index[k];
+      const int rank = f.rings.elevation_rank[f.rings.ring[i]] - 1;  // the beam above
+      ASSERT_GE(rank, 0);
+      const double elevation = f.rings.ring_elevation_rad[f.rings.order_by_elevation[rank]];
+      const double azimuth = f.rings.azimuth_rad[i];
+      const Eigen::Vector3d up_lidar(std::cos(elevation) * std::cos(azimuth),
+                                     std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+      const double t = sweep.point_time_s[i];
+      const Rigid3d T = TruthPose(s)(t);
+      sim::RayHit own, above;
+      const bool hit_own =
+          s.scene().Intersect(index, T.translation(),
+                              T.linear() * sweep.scan.points_lidar[i].normalized(), t, 130, &own);
+      const bool hit_above =
+          s.scene().Intersect(index, T.translation(), T.linear() * up_lidar, t, 130, &above);
+      same_object += hit_own && hit_above && own.object >= 0 && above.object == own.object;
+    }
+  });
   std::printf(
       "%zu folds within 3 m among %zu horizontal edge points, %zu on their own object; %zu "
       "unbounded\n",
