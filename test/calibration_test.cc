@@ -439,15 +439,33 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   OnlineCalibrator calibrator(online_options, online_start);
   // Alongside, the same run dropping the folds once acquired (Folds::kDropWhenTracking): until
   // the acquisition's last frame it reads what the default reads and ends where it does; from
-  // the next frame on its windows hold no fold.
+  // the next frame on its windows hold no fold, that frame updates at once (whatever
+  // tracking_update_every says: here never again), and the health still reads the folds.
   ASSERT_EQ(online_options.folds, OnlineCalibratorOptions::Folds::kKeep);
   OnlineCalibratorOptions dropping_options = online_options;
   dropping_options.folds = OnlineCalibratorOptions::Folds::kDropWhenTracking;
+  dropping_options.tracking_update_every = 1000;
   OnlineCalibrator dropping(dropping_options, online_start);
-  auto folds_read = [](const OnlineCalibrator& c) {
+  auto count_folds = [](const auto& frames) {
     size_t folds = 0;
-    for (const auto& f : c.RecentFrames()) folds += std::count(f->folds.begin(), f->folds.end(), 1);
+    for (const auto& f : frames) folds += std::count(f->folds.begin(), f->folds.end(), 1);
     return folds;
+  };
+  auto folds_read = [&](const OnlineCalibrator& c) { return count_folds(c.RecentFrames()); };
+  int dropped_frames = 0;
+  auto check_dropped = [&](const FrameReport& report) {
+    SCOPED_TRACE("frame " + std::to_string(report.frame) + ": " + report.reason);
+    EXPECT_EQ(folds_read(dropping), 0u);
+    EXPECT_GT(count_folds(dropping.HealthWindow()), 0u);
+    WindowScorer health_scorer(dropping.HealthWindow(), dropping.options().score);
+    EXPECT_EQ(report.health, HealthScore(&health_scorer, dropping.state()));
+    const bool first = dropped_frames++ == 0;
+    EXPECT_EQ(report.reason.find("folds dropped, a full step") == 0, first);
+    if (first) {
+      EXPECT_TRUE(report.ran_update());
+    } else if (report.health_before >= dropping_options.lost_health) {
+      EXPECT_FALSE(report.ran_update());  // tracking, next update in 1000 frames
+    }
   };
   size_t folds_while_acquiring = 0;
   FrameReport last;
@@ -462,7 +480,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
                   calibrator.state().T_camera_lidar.matrix())
           << "frame " << k;
     } else {
-      EXPECT_EQ(folds_read(dropping), 0u) << "frame " << k;
+      check_dropped(dropped);
       EXPECT_GT(folds_read(calibrator), 0u) << "frame " << k;
     }
     if (static_cast<int>(k) + 1 < online_options.window_frames) {
@@ -488,8 +506,8 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     later->camera_time_s += 20.0;
     ASSERT_GT(std::count(later->folds.begin(), later->folds.end(), 1), 0);
     ASSERT_FALSE(dropping.acquiring());
-    dropping.AddFrame(later);
-    EXPECT_EQ(folds_read(dropping), 0u);
+    check_dropped(dropping.AddFrame(later));
+    EXPECT_GT(dropped_frames, 0);
     EXPECT_LT(ComputeCalibrationError(dropping.state(), truth).rotation_deg, 0.5);
   }
   const CalibrationError online_error = ComputeCalibrationError(calibrator.state(), truth);

@@ -438,6 +438,18 @@ TEST(Cli, CalibratesALargeTimeOffsetAndNeverClaimsAWrongOne) {
       std::abs(result["time_offset_peak_s"].get<double>() - result["time_offset_s"].get<double>()),
       0.005);
 
+  // Dropping the folds once acquired: the acquisition ends at frame 9 and the polish holds the
+  // lateral and vertical translation, so the fold-free update right after it must move the whole
+  // way (measured 0.10°; 0.35° when it moved by the tracking gain, 0.14° with the folds kept).
+  const RunResult dropping =
+      CalibrateFromTwoDegrees(drive, tmp.path() + "/dropping", 3,
+                              std::string(kShortDrive) + " --lidar_folds=drop_when_tracking");
+  EXPECT_EQ(dropping.exit_code, 0) << dropping.output;
+  const nlohmann::json dropped =
+      nlohmann::json::parse(testing::ReadFile(tmp.path() + "/dropping/result.json"));
+  EXPECT_LT(dropped["error"]["rotation_deg"].get<double>(), 0.2) << dropping.output;
+  EXPECT_LT(std::abs(dropped["error"]["time_offset_s"].get<double>()), 0.006) << dropping.output;
+
   const std::string out = tmp.path() + "/no_scan";
   const RunResult local = CalibrateFromTwoDegrees(
       drive, out, 3, std::string(kShortDrive) + " --acquire_time_offset=false");

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <utility>
 
 namespace stcalib {
@@ -101,13 +102,18 @@ const std::shared_ptr<const CalibrationFrame>& OnlineCalibrator::InUse(
   return drop ? frame.without_folds : frame.all;
 }
 
-std::vector<const CalibrationFrame*> OnlineCalibrator::LatestFrames(int count) const {
+std::vector<const CalibrationFrame*> OnlineCalibrator::LatestFrames(int count,
+                                                                    bool with_folds) const {
   std::vector<const CalibrationFrame*> frames;
   const size_t n = std::min<size_t>(window_.size(), count);
   for (size_t k = window_.size() - n; k < window_.size(); ++k) {
-    frames.push_back(InUse(window_[k]).get());
+    frames.push_back(with_folds ? window_[k].all.get() : InUse(window_[k]).get());
   }
   return frames;
+}
+
+std::vector<const CalibrationFrame*> OnlineCalibrator::HealthWindow() const {
+  return LatestFrames(options_.window_frames, /*with_folds=*/true);
 }
 
 std::vector<const CalibrationFrame*> OnlineCalibrator::SearchWindow() const {
@@ -156,9 +162,14 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   last_camera_time_s_ = frame->camera_time_s;
   // From the first frame after the acquisition (its last update and a polish right after it read
   // the frames the estimate was acquired on). Without the grid's acquisition there is none to
-  // end, and the folds stay. Once dropped they stay out, of a lost estimate's grid too.
-  if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && !acquiring_) {
+  // end, and the folds stay. Once dropped they stay out, of a lost estimate's grid too. The
+  // frame they are first dropped on updates at once and by a full step (`refit`): the estimate
+  // was acquired with the folds, and its translation carries their bias.
+  bool refit = false;
+  if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && !acquiring_ &&
+      !folds_dropped_) {
     folds_dropped_ = true;
+    refit = true;
   }
   FrameReport report;
   report.frame = frame->index;
@@ -184,7 +195,12 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   WindowScorer scorer(frames, options_.score);
   report.score_before = scorer.Evaluate(state_, -1);
   report.gray_rate_before = scorer.GrayRate(state_);
-  report.health_before = HealthScore(&scorer, state_, kHealthRotationDeg, kHealthTranslationM,
+  // The health reads every point, folds included (see HealthWindow).
+  const std::vector<const CalibrationFrame*> health_frames = HealthWindow();
+  std::optional<WindowScorer> own_health_scorer;
+  if (health_frames != frames) own_health_scorer.emplace(health_frames, options_.score);
+  WindowScorer* health_scorer = own_health_scorer ? &*own_health_scorer : &scorer;
+  report.health_before = HealthScore(health_scorer, state_, kHealthRotationDeg, kHealthTranslationM,
                                      nullptr, &health_cache_);
   if (options_.wait_for_full_window && static_cast<int>(frames.size()) < options_.window_frames) {
     return KeepEstimate(report, "window filling (" + std::to_string(frames.size()) + " of " +
@@ -193,7 +209,8 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   }
   const bool tracking = !acquiring() && report.health_before >= options_.lost_health &&
                         static_cast<int>(frames.size()) >= options_.window_frames;
-  if (tracking && !update_now && ++frames_since_update_ < options_.tracking_update_every) {
+  if (tracking && !update_now && !refit &&
+      ++frames_since_update_ < options_.tracking_update_every) {
     RememberIfHealthy(report.health_before, frames.size());
     return KeepEstimate(report,
                         "tracking: healthy, next update in " +
@@ -216,9 +233,11 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
       Refine(refine_frames, report.search.state, report.search.state, anchor_, options_.refine);
   report.refine_ms = MillisecondsSince(start);
 
-  Choose(Candidates(&scorer, search_options, &report), &long_scorer, search_options, &report);
+  Choose(Candidates(&scorer, search_options, &report), &long_scorer, search_options, refit,
+         &report);
+  if (refit) report.reason = "folds dropped, a full step: " + report.reason;
   state_ = report.after;
-  MeasureEstimate(&scorer, report.accepted, &report);
+  MeasureEstimate(&scorer, health_scorer, report.accepted, &report);
   RememberIfHealthy(report.health, frames.size());
   return report;
 }
@@ -286,7 +305,8 @@ FrameReport OnlineCalibrator::Polish() {
   report.reason = "polish: refined over " + std::to_string(frames.size()) + " frames" + pair_text;
   // On the search window, like a frame's.
   WindowScorer scorer(SearchWindow(), options_.score);
-  MeasureEstimate(&scorer, true, &report);
+  WindowScorer health_scorer(HealthWindow(), options_.score);
+  MeasureEstimate(&scorer, &health_scorer, true, &report);
   return report;
 }
 
@@ -305,12 +325,13 @@ FrameReport OnlineCalibrator::KeepEstimate(FrameReport report, const std::string
   return report;
 }
 
-void OnlineCalibrator::MeasureEstimate(WindowScorer* scorer, bool moved, FrameReport* report) {
+void OnlineCalibrator::MeasureEstimate(WindowScorer* scorer, WindowScorer* health_scorer,
+                                       bool moved, FrameReport* report) {
   report->score_after = scorer->Evaluate(state_, -1);
   report->gray_rate_after = scorer->GrayRate(state_);
   // The health of an unchanged estimate is the one measured before.
-  report->health = moved ? HealthScore(scorer, state_, kHealthRotationDeg, kHealthTranslationM,
-                                       nullptr, &health_cache_)
+  report->health = moved ? HealthScore(health_scorer, state_, kHealthRotationDeg,
+                                       kHealthTranslationM, nullptr, &health_cache_)
                          : report->health_before;
   last_health_ = report->health;
 }
@@ -401,7 +422,7 @@ std::vector<OnlineCalibrator::Candidate> OnlineCalibrator::Candidates(
 }
 
 void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowScorer* long_scorer,
-                              const AdaptiveGridSearchOptions& search_options,
+                              const AdaptiveGridSearchOptions& search_options, bool full_step,
                               FrameReport* report) const {
   // Judged on all the refinement's frames (a longer and steadier window than the search's): the
   // best candidate within the bounds, when it scores at least as well as the current estimate.
@@ -448,7 +469,8 @@ void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowSc
   // window is suspect, and a KITTI run's lost window at frame 28 moved the translation 5 cm with a
   // full jump.
   const bool acquired = !report->acquiring && has_last_healthy_;
-  if (report->accepted && (!report->coarse_search || acquired) && options_.tracking_gain < 1.0) {
+  if (report->accepted && !full_step && (!report->coarse_search || acquired) &&
+      options_.tracking_gain < 1.0) {
     const CalibrationState& c = report->after;
     const double g = options_.tracking_gain;
     const double g_rotation = report->coarse_search ? 1.0 : g;
