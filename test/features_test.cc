@@ -461,6 +461,39 @@ TEST(LidarEdges, FoldsAreCornersOfTheirOwnObject) {
   EXPECT_GE(static_cast<double>(same_object) / folds, 0.9);
 }
 
+// Select and Append carry every per-point field with its point; a field out of step with the
+// points is a programmer error.
+TEST(LidarEdges, SelectAndAppendCarryEveryField) {
+  LidarEdges edges;
+  for (int i = 0; i < 4; ++i) {
+    edges.points_lidar.push_back(Eigen::Vector3d(i, 0, 0));
+    edges.time_s.push_back(0.01 * i);
+    edges.kind.push_back(i % 2 ? EdgeKind::kHorizontal : EdgeKind::kVertical);
+    edges.source_index.push_back(100 + i);
+    edges.offset_rate.push_back(Eigen::Vector3d(0, 0, i));
+    edges.fold.push_back(i == 3 ? 1 : 0);
+  }
+  LidarEdges picked = edges.Select({3, 0});
+  picked.Append(edges.Select({1}));
+  ASSERT_EQ(picked.size(), 3u);
+  const int expected[] = {3, 0, 1};
+  for (size_t k = 0; k < 3; ++k) {
+    const int i = expected[k];
+    EXPECT_EQ(picked.points_lidar[k].x(), i);
+    EXPECT_EQ(picked.time_s[k], 0.01 * i);
+    EXPECT_EQ(picked.kind[k], i % 2 ? EdgeKind::kHorizontal : EdgeKind::kVertical);
+    EXPECT_EQ(picked.source_index[k], 100 + i);
+    EXPECT_EQ(picked.offset_rate[k].z(), i);
+    EXPECT_EQ(picked.fold[k], i == 3 ? 1 : 0);
+  }
+  EXPECT_TRUE(edges.Select({}).empty());
+  LidarEdges broken = edges;
+  broken.time_s.pop_back();
+  EXPECT_DEATH(broken.Select({0}), "one entry per point");
+  EXPECT_DEATH(picked.Append(broken), "one entry per point");
+  EXPECT_DEATH(edges.Select({4}), "index 4");
+}
+
 TEST(Ground, PlaneSeparatesSimulatedGroundLabels) {
   SimulatorOptions options;
   options.seed = 5;

@@ -12,6 +12,23 @@ namespace {
 
 constexpr float kNoReturn = std::numeric_limits<float>::infinity();
 
+// Calls f(to.field, from.field) for every per-point field of LidarEdges: the one list of them.
+template <typename To, typename F>
+void ForEachPointField(To &to, const LidarEdges &from, F f) {
+  f(to.points_lidar, from.points_lidar);
+  f(to.time_s, from.time_s);
+  f(to.kind, from.kind);
+  f(to.source_index, from.source_index);
+  f(to.offset_rate, from.offset_rate);
+  f(to.fold, from.fold);
+}
+
+void CheckPointFields(const LidarEdges &edges) {
+  ForEachPointField(edges, edges, [&](const auto &, const auto &field) {
+    CHECK_EQ(field.size(), edges.size()) << "LidarEdges: one entry per point in every field";
+  });
+}
+
 // Keeps edge points supported by neighbours of the same run (see
 // LidarEdgeOptions::run_support).
 LidarEdges KeepRuns(const LidarEdges &edges, const ScanRings &rings,
@@ -39,7 +56,7 @@ LidarEdges KeepRuns(const LidarEdges &edges, const ScanRings &rings,
     }
     return count;
   };
-  LidarEdges kept;
+  std::vector<int> kept;
   for (size_t k = 0; k < edges.size(); ++k) {
     const int ring = rings.ring[edges.source_index[k]];
     int support = 0;
@@ -54,15 +71,9 @@ LidarEdges KeepRuns(const LidarEdges &edges, const ScanRings &rings,
     } else {
       support = supporters(k, ring, EdgeKind::kHorizontal, along_window);
     }
-    if (support < options.run_support) continue;
-    kept.points_lidar.push_back(edges.points_lidar[k]);
-    kept.time_s.push_back(edges.time_s[k]);
-    kept.kind.push_back(edges.kind[k]);
-    kept.source_index.push_back(edges.source_index[k]);
-    kept.offset_rate.push_back(edges.offset_rate[k]);
-    kept.fold.push_back(edges.fold[k]);
+    if (support >= options.run_support) kept.push_back(static_cast<int>(k));
   }
-  return kept;
+  return edges.Select(kept);
 }
 
 }  // namespace
@@ -82,14 +93,24 @@ Status LidarEdgeOptions::Validate() const {
 }
 
 void LidarEdges::Append(const LidarEdges &other) {
-  CHECK_EQ(fold.size(), size()) << "LidarEdges::fold: one entry per point";
-  CHECK_EQ(other.fold.size(), other.size()) << "LidarEdges::fold: one entry per point";
-  points_lidar.insert(points_lidar.end(), other.points_lidar.begin(), other.points_lidar.end());
-  time_s.insert(time_s.end(), other.time_s.begin(), other.time_s.end());
-  kind.insert(kind.end(), other.kind.begin(), other.kind.end());
-  source_index.insert(source_index.end(), other.source_index.begin(), other.source_index.end());
-  offset_rate.insert(offset_rate.end(), other.offset_rate.begin(), other.offset_rate.end());
-  fold.insert(fold.end(), other.fold.begin(), other.fold.end());
+  CheckPointFields(*this);
+  CheckPointFields(other);
+  ForEachPointField(*this, other, [](auto &to, const auto &from) {
+    to.insert(to.end(), from.begin(), from.end());
+  });
+}
+
+LidarEdges LidarEdges::Select(const std::vector<int> &indices) const {
+  CheckPointFields(*this);
+  LidarEdges out;
+  ForEachPointField(out, *this, [&](auto &to, const auto &from) {
+    to.reserve(indices.size());
+    for (int i : indices) {
+      CHECK(i >= 0 && static_cast<size_t>(i) < from.size()) << "LidarEdges::Select: index " << i;
+      to.push_back(from[i]);
+    }
+  });
+  return out;
 }
 
 LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,

@@ -71,6 +71,8 @@ struct LidarEdges {
   size_t size() const { return points_lidar.size(); }
   bool empty() const { return points_lidar.empty(); }
   void Append(const LidarEdges& other);
+  // The points at `indices` (in that order), every per-point field with them.
+  LidarEdges Select(const std::vector<int>& indices) const;
 };
 
 // `use` (optional, one entry per point) marks ground and dynamic points; `point_time_s` gives
