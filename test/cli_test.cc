@@ -449,6 +449,8 @@ TEST(Cli, CalibratesALargeTimeOffsetAndNeverClaimsAWrongOne) {
       nlohmann::json::parse(testing::ReadFile(tmp.path() + "/dropping/result.json"));
   EXPECT_LT(dropped["error"]["rotation_deg"].get<double>(), 0.2) << dropping.output;
   EXPECT_LT(std::abs(dropped["error"]["time_offset_s"].get<double>()), 0.006) << dropping.output;
+  EXPECT_THAT(testing::ReadFile(tmp.path() + "/dropping/per_frame.csv"),
+              HasSubstr("folds dropped, a full step"));
 
   const std::string out = tmp.path() + "/no_scan";
   const RunResult local = CalibrateFromTwoDegrees(

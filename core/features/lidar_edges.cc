@@ -102,13 +102,13 @@ void LidarEdges::Append(const LidarEdges &other) {
 
 LidarEdges LidarEdges::Select(const std::vector<int> &indices) const {
   CheckPointFields(*this);
+  for (int i : indices) {
+    CHECK(i >= 0 && static_cast<size_t>(i) < size()) << "LidarEdges::Select: index " << i;
+  }
   LidarEdges out;
   ForEachPointField(out, *this, [&](auto &to, const auto &from) {
     to.reserve(indices.size());
-    for (int i : indices) {
-      CHECK(i >= 0 && static_cast<size_t>(i) < from.size()) << "LidarEdges::Select: index " << i;
-      to.push_back(from[i]);
-    }
+    for (int i : indices) to.push_back(from[i]);
   });
   return out;
 }

@@ -116,6 +116,15 @@ std::vector<const CalibrationFrame*> OnlineCalibrator::HealthWindow() const {
   return LatestFrames(options_.window_frames, /*with_folds=*/true);
 }
 
+WindowScorer* OnlineCalibrator::HealthScorer(const std::vector<const CalibrationFrame*>& window,
+                                             WindowScorer* scorer,
+                                             std::optional<WindowScorer>* own) const {
+  const std::vector<const CalibrationFrame*> health_window = HealthWindow();
+  if (health_window == window) return scorer;
+  own->emplace(health_window, options_.score);
+  return &**own;
+}
+
 std::vector<const CalibrationFrame*> OnlineCalibrator::SearchWindow() const {
   return LatestFrames(options_.window_frames);
 }
@@ -163,14 +172,14 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   // From the first frame after the acquisition (its last update and a polish right after it read
   // the frames the estimate was acquired on). Without the grid's acquisition there is none to
   // end, and the folds stay. Once dropped they stay out, of a lost estimate's grid too. The
-  // frame they are first dropped on updates at once and by a full step (`refit`): the estimate
-  // was acquired with the folds, and its translation carries their bias.
-  bool refit = false;
+  // first frame without them that updates does so at once and by a full step (`refit`): the
+  // estimate was acquired with the folds, and its translation carries their bias.
   if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && !acquiring_ &&
       !folds_dropped_) {
     folds_dropped_ = true;
-    refit = true;
+    refit_pending_ = true;
   }
+  const bool refit = refit_pending_;
   FrameReport report;
   report.frame = frame->index;
   report.acquiring = acquiring();
@@ -196,10 +205,8 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   report.score_before = scorer.Evaluate(state_, -1);
   report.gray_rate_before = scorer.GrayRate(state_);
   // The health reads every point, folds included (see HealthWindow).
-  const std::vector<const CalibrationFrame*> health_frames = HealthWindow();
   std::optional<WindowScorer> own_health_scorer;
-  if (health_frames != frames) own_health_scorer.emplace(health_frames, options_.score);
-  WindowScorer* health_scorer = own_health_scorer ? &*own_health_scorer : &scorer;
+  WindowScorer* health_scorer = HealthScorer(frames, &scorer, &own_health_scorer);
   report.health_before = HealthScore(health_scorer, state_, kHealthRotationDeg, kHealthTranslationM,
                                      nullptr, &health_cache_);
   if (options_.wait_for_full_window && static_cast<int>(frames.size()) < options_.window_frames) {
@@ -235,7 +242,7 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
 
   Choose(Candidates(&scorer, search_options, &report), &long_scorer, search_options, refit,
          &report);
-  if (refit) report.reason = "folds dropped, a full step: " + report.reason;
+  refit_pending_ = false;
   state_ = report.after;
   MeasureEstimate(&scorer, health_scorer, report.accepted, &report);
   RememberIfHealthy(report.health, frames.size());
@@ -303,10 +310,11 @@ FrameReport OnlineCalibrator::Polish() {
                   1000 * pair.std_dev[6], pair.time_forward_correlation);
   }
   report.reason = "polish: refined over " + std::to_string(frames.size()) + " frames" + pair_text;
-  // On the search window, like a frame's.
-  WindowScorer scorer(SearchWindow(), options_.score);
-  WindowScorer health_scorer(HealthWindow(), options_.score);
-  MeasureEstimate(&scorer, &health_scorer, true, &report);
+  // On the search window (the health on HealthWindow), like a frame's.
+  const std::vector<const CalibrationFrame*> window = SearchWindow();
+  WindowScorer scorer(window, options_.score);
+  std::optional<WindowScorer> own_health_scorer;
+  MeasureEstimate(&scorer, HealthScorer(window, &scorer, &own_health_scorer), true, &report);
   return report;
 }
 
@@ -468,9 +476,12 @@ void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowSc
   // healthy once): the translation and δ were estimated over the acquisition's frames, a lost
   // window is suspect, and a KITTI run's lost window at frame 28 moved the translation 5 cm with a
   // full jump.
+  // The first update without the folds (full_step) moves the whole way, unless it is lost.
   const bool acquired = !report->acquiring && has_last_healthy_;
-  if (report->accepted && !full_step && (!report->coarse_search || acquired) &&
-      options_.tracking_gain < 1.0) {
+  if (report->accepted && full_step && !report->coarse_search) {
+    report->reason = "folds dropped, a full step: " + report->reason;
+  } else if (report->accepted && (!report->coarse_search || acquired) &&
+             options_.tracking_gain < 1.0) {
     const CalibrationState& c = report->after;
     const double g = options_.tracking_gain;
     const double g_rotation = report->coarse_search ? 1.0 : g;

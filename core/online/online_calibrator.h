@@ -3,6 +3,7 @@
 #include <deque>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "core/refine/refine.h"
@@ -75,7 +76,8 @@ struct OnlineCalibratorOptions {
   bool search_from_last_healthy = true;
   // While tracking (not lost; once acquired, a lost update's translation and δ too), an accepted
   // update moves this share of the way to the new estimate: a first-order filter that averages the
-  // scatter of single windows (on a street they scatter by a few tenths of a degree).
+  // scatter of single windows (on a street they scatter by a few tenths of a degree). Not the
+  // first update without the folds (Folds::kDropWhenTracking): it moves the whole way.
   double tracking_gain = 0.3;
   // Candidates are judged by their window score (the score map: a wide basin, but its peak can sit
   // a few tenths of a degree from the refinement's optimum). The refined rotation, with the chosen
@@ -90,14 +92,17 @@ struct OnlineCalibratorOptions {
   double refined_score_tolerance = 0.1;
   // While tracking (acquisition over, a full window, health at least lost_health), the search
   // and refinement run on every n-th frame only; the frames between join the window and have
-  // their health measured, and a frame whose health falls below lost_health runs at once. With
+  // their health measured, and a frame whose health falls below lost_health runs at once (so does
+  // the first frame without the folds, Folds::kDropWhenTracking). With
   // n = window_frames every frame lies in exactly one searched window and in every refinement
   // that covers it: the same data, read once instead of n times. 1 = update on every frame.
   int tracking_update_every = 3;
   // The LiDAR edges' folds (LidarEdgeOptions::fold_height_tolerance_m): kept, dropped from every
   // window, or dropped once acquired (from the first frame after the acquisition: the grid, the δ
-  // scan and the updates that acquire read them; tracking, refinement, polish and verdict do
-  // not). Folds bias the vertical translation (2-5 cm on simulated drives) and KITTI's roll, but
+  // scan and the updates that acquire read them; tracking, refinement, polish and the verdict's
+  // profiles do not). Whatever the choice, the health (a frame's, the lost test's, the verdict's
+  // final health) reads every point: see HealthWindow. (kDrop was measured below before that.)
+  // Folds bias the vertical translation (2-5 cm on simulated drives) and KITTI's roll, but
   // the first frames' search needs them. Measured (scripts/sweep, 30 runs; 40-frame simulated
   // drives, seeds 1-6), against kKeep:
   //  - kDropWhenTracking: the frame the folds are first dropped on updates at once and by a full
@@ -256,12 +261,17 @@ class OnlineCalibrator {
                                     FrameReport* report) const;
   // The best candidate within the bounds that scores at least as well as the estimate on the
   // refinement's frames, moved by tracking_gain while tracking (after the acquisition, a lost
-  // update's translation and δ too): fills report->after.
+  // update's translation and δ too; the whole way when `full_step` and not lost): fills
+  // report->after.
   void Choose(const std::vector<Candidate>& candidates, WindowScorer* long_scorer,
               const AdaptiveGridSearchOptions& search_options, bool full_step,
               FrameReport* report) const;
 
   // Score, gray rate and health at the estimate (health_before reused when it did not move).
+  // `scorer` when `window` (the search window as read now) is HealthWindow() (Folds::kKeep, or
+  // folds not dropped yet), else a scorer of HealthWindow() built in `own`.
+  WindowScorer* HealthScorer(const std::vector<const CalibrationFrame*>& window,
+                             WindowScorer* scorer, std::optional<WindowScorer>* own) const;
   // `health_scorer` reads HealthWindow().
   void MeasureEstimate(WindowScorer* scorer, WindowScorer* health_scorer, bool moved,
                        FrameReport* report);
@@ -276,6 +286,7 @@ class OnlineCalibrator {
   CalibrationState anchor_;     ///< the initial calibration: the search's bounds are around it
   bool acquiring_ = true;       ///< see OnlineCalibratorOptions::acquire_with_grid
   bool folds_dropped_ = false;  ///< OnlineCalibratorOptions::Folds::kDropWhenTracking in effect
+  bool refit_pending_ = false;  ///< the first update without the folds has not run yet
   // The latest estimate whose health reached lost_health after a full window: when the estimate
   // is lost, a search from there is a candidate too (a disturbance or a wrong jump).
   bool has_last_healthy_ = false;
