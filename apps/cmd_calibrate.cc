@@ -528,7 +528,7 @@ std::string CalibrateFlagsError() {
   if (FLAGS_loss != "cauchy" && FLAGS_loss != "huber") return "--loss must be cauchy or huber";
   OnlineCalibratorOptions::Folds folds;
   if (!ParseFolds(FLAGS_lidar_folds, &folds)) {
-    return "--lidar_folds must be keep, drop or drop_when_tracking";
+    return "--lidar_folds must be " + FoldsChoices();
   }
   return "";
 }

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <utility>
@@ -75,6 +76,15 @@ bool ParseFolds(const std::string& name, OnlineCalibratorOptions::Folds* folds) 
     }
   }
   return false;
+}
+
+std::string FoldsChoices() {
+  std::string text;
+  const size_t n = std::size(kFoldsNames);
+  for (size_t k = 0; k < n; ++k) {
+    text += (k == 0 ? "" : k + 1 == n ? " or " : ", ") + std::string(kFoldsNames[k].second);
+  }
+  return text;
 }
 
 OnlineCalibratorOptions WithSharedSettings(const OnlineCalibratorOptions& options) {

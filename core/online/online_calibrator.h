@@ -134,6 +134,8 @@ struct OnlineCalibratorOptions {
 const char* FoldsName(OnlineCalibratorOptions::Folds folds);
 // False, `folds` untouched, when `name` is none of them.
 bool ParseFolds(const std::string& name, OnlineCalibratorOptions::Folds* folds);
+// The names, for a message: "keep, drop or drop_when_tracking".
+std::string FoldsChoices();
 
 // δ against the translation along the direction of travel, from a solve with both free (the
 // polish's first). While tracking, the forward translation is held by its prior, so a tracking
