@@ -220,17 +220,19 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
     if (g == groups.size()) groups.emplace_back();
     groups[g].push_back(n);
   }
-  size_t largest_group = 0;
-  for (const std::vector<size_t>& group : groups)
-    largest_group = std::max(largest_group, group.size());
-  struct Lanes {
-    std::vector<double> bx, by, bz, depth_offset, u, v;
-    std::vector<uint8_t> in_front;
-  } lane;
-  for (auto* a : {&lane.bx, &lane.by, &lane.bz, &lane.depth_offset, &lane.u, &lane.v}) {
-    a->resize(largest_group);
-  }
-  lane.in_front.resize(largest_group);
+  // Each group's translations as arrays (b = K·R_rect·t + p4 and the depth offset), laid out
+  // group after group, so that the projection of a point under all of a group's translations is
+  // one vectorised loop.
+  std::vector<size_t> lane_begin(groups.size() + 1, 0);
+  for (size_t g = 0; g < groups.size(); ++g) lane_begin[g + 1] = lane_begin[g] + groups[g].size();
+  const size_t lanes = lane_begin.back();
+  std::vector<double> bx(lanes), by(lanes), bz(lanes), depth_offset(lanes), u(lanes), v(lanes);
+  std::vector<uint8_t> in_front(lanes);
+  // Per lane, its state's sums (ScoreValue::score, ::projected), point by point in order.
+  std::vector<double> score(lanes, 0.0);
+  std::vector<int> projected(lanes, 0);
+  std::vector<Eigen::Matrix3d> M(groups.size());
+  std::vector<Eigen::Vector3d> depth_row(groups.size());
   double weight_sum = 0;
   for (size_t f = begin; f < end; ++f) {
     const CalibrationFrame& cf = *frames_[f];
@@ -243,46 +245,61 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
     for (size_t k = 0; k < moved.size(); ++k) weight_sum += weights_[f][k];
     // As EvaluateOn: h = M·p + b, depth = depth_row·p + depth_offset.
     const Eigen::Matrix3d KR = cf.camera.P_rect_02.leftCols<3>() * cf.camera.R_rect_00;
-    for (const std::vector<size_t>& group : groups) {
-      const Eigen::Matrix3d& R = states[group.front()].T_camera_lidar.linear();
-      const Eigen::Matrix3d M = KR * R;
-      const Eigen::Vector3d depth_row = cf.camera.R_rect_00.row(2) * R;
-      // The group's translations as arrays, so that the projection of a point under all of them
-      // is one vectorised loop; then the samples. Each state still sums its points in order.
-      const size_t m = group.size();
-      for (size_t j = 0; j < m; ++j) {
-        const Eigen::Vector3d& t = states[group[j]].T_camera_lidar.translation();
+    for (size_t g = 0; g < groups.size(); ++g) {
+      const Eigen::Matrix3d& R = states[groups[g].front()].T_camera_lidar.linear();
+      M[g] = KR * R;
+      depth_row[g] = (cf.camera.R_rect_00.row(2) * R).transpose();
+      for (size_t j = 0; j < groups[g].size(); ++j) {
+        const Eigen::Vector3d& t = states[groups[g][j]].T_camera_lidar.translation();
         const Eigen::Vector3d b = KR * t + cf.camera.P_rect_02.col(3);
-        lane.bx[j] = b.x();
-        lane.by[j] = b.y();
-        lane.bz[j] = b.z();
-        lane.depth_offset[j] = cf.camera.R_rect_00.row(2).dot(t);
+        const size_t lane = lane_begin[g] + j;
+        bx[lane] = b.x();
+        by[lane] = b.y();
+        bz[lane] = b.z();
+        depth_offset[lane] = cf.camera.R_rect_00.row(2).dot(t);
       }
-      // Unaliased lanes, so that the divisions vectorise (each is still one IEEE division).
-      const double* __restrict bx = lane.bx.data();
-      const double* __restrict by = lane.by.data();
-      const double* __restrict bz = lane.bz.data();
-      const double* __restrict depth_offset = lane.depth_offset.data();
-      double* __restrict u = lane.u.data();
-      double* __restrict v = lane.v.data();
-      uint8_t* __restrict in_front = lane.in_front.data();
-      const double min_depth_m = cf.camera.min_depth_m;
-      for (size_t k = 0; k < moved.size(); ++k) {
-        const float w = weights_[f][k];
-        const double depth = depth_row.dot(moved[k]);
-        const Eigen::Vector3d Mp = M * moved[k];
+    }
+    const double min_depth_m = cf.camera.min_depth_m;
+    // Point by point, every state: one point's samples under all the states lie within a few
+    // pixels of each other, so they stay in the cache (state by state, every point, they were
+    // fetched again for each rotation). Each state still sums its points in order.
+    for (size_t k = 0; k < moved.size(); ++k) {
+      const float w = weights_[f][k];
+      const MapView& map = maps[kinds_[f][k]];
+      for (size_t g = 0; g < groups.size(); ++g) {
+        const double depth = depth_row[g].dot(moved[k]);
+        const Eigen::Vector3d Mp = M[g] * moved[k];
         const double mx = Mp.x(), my = Mp.y(), mz = Mp.z();
-        const MapView& map = maps[kinds_[f][k]];
+        const size_t first = lane_begin[g], m = groups[g].size();
+        // Unaliased lanes, so that the divisions vectorise (each is still one IEEE division).
+        const double* __restrict gbx = bx.data() + first;
+        const double* __restrict gby = by.data() + first;
+        const double* __restrict gbz = bz.data() + first;
+        const double* __restrict gdepth = depth_offset.data() + first;
+        double* __restrict gu = u.data() + first;
+        double* __restrict gv = v.data() + first;
+        uint8_t* __restrict gfront = in_front.data() + first;
         for (size_t j = 0; j < m; ++j) {
-          const double hz = mz + bz[j];
-          u[j] = (mx + bx[j]) / hz;
-          v[j] = (my + by[j]) / hz;
+          const double hz = mz + gbz[j];
+          gu[j] = (mx + gbx[j]) / hz;
+          gv[j] = (my + gby[j]) / hz;
         }
-        for (size_t j = 0; j < m; ++j) in_front[j] = !(depth + depth_offset[j] < min_depth_m);
+        for (size_t j = 0; j < m; ++j) gfront[j] = !(depth + gdepth[j] < min_depth_m);
+        double* __restrict gscore = score.data() + first;
+        int* __restrict gprojected = projected.data() + first;
         for (size_t j = 0; j < m; ++j) {
-          if (in_front[j]) AddSample(u[j], v[j], map, w, &values[group[j]]);
+          if (!gfront[j]) continue;
+          const double uj = gu[j], vj = gv[j];
+          if (uj >= 0 && vj >= 0 && uj < map.cols && vj < map.rows) ++gprojected[j];
+          gscore[j] += w * Sample(map, uj, vj);
         }
       }
+    }
+  }
+  for (size_t g = 0; g < groups.size(); ++g) {
+    for (size_t j = 0; j < groups[g].size(); ++j) {
+      values[groups[g][j]].score = score[lane_begin[g] + j];
+      values[groups[g][j]].projected = projected[lane_begin[g] + j];
     }
   }
   for (ScoreValue& value : values) {
