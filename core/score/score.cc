@@ -38,16 +38,17 @@ inline float Sample(const MapView& map, double u, double v) {
 
 // One point's share of a score: the map at its pixel (u, v), weighted, and whether it landed in
 // the image.
-inline void AddSample(double u, double v, const MapView& map, float w, ScoreValue* value) {
+inline void AddSample(double u, double v, const MapView& map, float w, double* score,
+                      int* projected) {
   const float s = Sample(map, u, v);
-  if (u >= 0 && v >= 0 && u < map.cols && v < map.rows) ++value->projected;
-  value->score += w * s;
+  if (u >= 0 && v >= 0 && u < map.cols && v < map.rows) ++*projected;
+  *score += w * s;
 }
 
 // The same at the projection of h = K·R_rect·p_camera + p4.
 inline void AddProjection(const Eigen::Vector3d& h, const MapView& map, float w,
                           ScoreValue* value) {
-  AddSample(h.x() / h.z(), h.y() / h.z(), map, w, value);
+  AddSample(h.x() / h.z(), h.y() / h.z(), map, w, &value->score, &value->projected);
 }
 
 }  // namespace
@@ -288,10 +289,7 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
         double* __restrict gscore = score.data() + first;
         int* __restrict gprojected = projected.data() + first;
         for (size_t j = 0; j < m; ++j) {
-          if (!gfront[j]) continue;
-          const double uj = gu[j], vj = gv[j];
-          if (uj >= 0 && vj >= 0 && uj < map.cols && vj < map.rows) ++gprojected[j];
-          gscore[j] += w * Sample(map, uj, vj);
+          if (gfront[j]) AddSample(gu[j], gv[j], map, w, &gscore[j], &gprojected[j]);
         }
       }
     }
