@@ -138,9 +138,9 @@ DEFINE_string(
     lidar_folds, stcalib::FoldsName(kOnline.folds),
     "calibrate: LiDAR horizontal edges below the sensor whose beam above returns at their "
     "own height (a top's front corner seen from above, or its outline against a "
-    "background at that height): keep | drop | drop_when_tracking (dropped from the "
-    "first frame after the acquisition, which then updates by a full step); the health "
-    "always reads them");
+    "background at that height): keep | drop | drop_when_tracking (the default: dropped "
+    "from the first frame after the acquisition, which then updates by a full step); the "
+    "health always reads them");
 DEFINE_double(point_margin, kOnline.point_margin,
               "calibrate: LiDAR edge points are kept when they project inside the image shrunk by "
               "this share of its size (negative: grown) at the estimate when their frame arrives");

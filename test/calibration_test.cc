@@ -436,12 +436,14 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   online_options.refine_frames = 10;
   const CalibrationState online_start = Step(truth, Eigen::Vector3d(-2, 2, -2) * M_PI / 180.0,
                                              Eigen::Vector3d(0.05, -0.05, 0.05), -0.03);
+  // `calibrator` keeps the folds throughout (Folds::kKeep). Alongside, the same run dropping them
+  // once acquired (Folds::kDropWhenTracking, the default): until the acquisition's last frame it
+  // reads what `calibrator` reads and ends where it does; from the next frame on its windows
+  // hold no fold, that frame updates at once (whatever tracking_update_every says: here never
+  // again), and the health still reads the folds.
+  ASSERT_EQ(online_options.folds, OnlineCalibratorOptions::Folds::kDropWhenTracking);
+  online_options.folds = OnlineCalibratorOptions::Folds::kKeep;
   OnlineCalibrator calibrator(online_options, online_start);
-  // Alongside, the same run dropping the folds once acquired (Folds::kDropWhenTracking): until
-  // the acquisition's last frame it reads what the default reads and ends where it does; from
-  // the next frame on its windows hold no fold, that frame updates at once (whatever
-  // tracking_update_every says: here never again), and the health still reads the folds.
-  ASSERT_EQ(online_options.folds, OnlineCalibratorOptions::Folds::kKeep);
   OnlineCalibratorOptions dropping_options = online_options;
   dropping_options.folds = OnlineCalibratorOptions::Folds::kDropWhenTracking;
   dropping_options.tracking_update_every = 1000;

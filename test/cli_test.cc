@@ -433,23 +433,16 @@ TEST(Cli, CalibratesALargeTimeOffsetAndNeverClaimsAWrongOne) {
   const nlohmann::json result =
       nlohmann::json::parse(testing::ReadFile(tmp.path() + "/scan/result.json"));
   EXPECT_LT(std::abs(result["error"]["time_offset_s"].get<double>()), 0.006) << r.output;
-  EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.3) << r.output;
   EXPECT_LT(
       std::abs(result["time_offset_peak_s"].get<double>() - result["time_offset_s"].get<double>()),
       0.005);
 
-  // Dropping the folds once acquired: the acquisition ends at frame 9 and the polish holds the
-  // lateral and vertical translation, so the fold-free update right after it must move the whole
-  // way (measured 0.10°; 0.35° when it moved by the tracking gain, 0.14° with the folds kept).
-  const RunResult dropping =
-      CalibrateFromTwoDegrees(drive, tmp.path() + "/dropping", 3,
-                              std::string(kShortDrive) + " --lidar_folds=drop_when_tracking");
-  EXPECT_EQ(dropping.exit_code, 0) << dropping.output;
-  const nlohmann::json dropped =
-      nlohmann::json::parse(testing::ReadFile(tmp.path() + "/dropping/result.json"));
-  EXPECT_LT(dropped["error"]["rotation_deg"].get<double>(), 0.2) << dropping.output;
-  EXPECT_LT(std::abs(dropped["error"]["time_offset_s"].get<double>()), 0.006) << dropping.output;
-  EXPECT_THAT(testing::ReadFile(tmp.path() + "/dropping/per_frame.csv"),
+  // The folds are dropped once acquired (the default): the acquisition ends at frame 9 and the
+  // polish holds the lateral and vertical translation, so the fold-free update right after it
+  // must move the whole way (measured 0.10°; 0.35° when it moved by the tracking gain, 0.14°
+  // with the folds kept).
+  EXPECT_LT(result["error"]["rotation_deg"].get<double>(), 0.2) << r.output;
+  EXPECT_THAT(testing::ReadFile(tmp.path() + "/scan/per_frame.csv"),
               HasSubstr("folds dropped, a full step"));
 
   const std::string out = tmp.path() + "/no_scan";
@@ -683,14 +676,14 @@ TEST(Cli, KittiFifthFrameTakesTheRefinedRotationWithinTheScoreTolerance) {
   EXPECT_LT(sum_default, sum_best_score - 0.3);
 }
 
-// δ started 50 ms off and the δ scan switched off: the estimate ends on a side peak about 4°
-// from KITTI's calibration. The last window's health is under the calibrator's own lost_health
-// (0.9), and that alone would refuse it: with an update on every frame the profiles and the
-// suppressed check let it through (mean health 0.865, limit 0.85) and the final health (0.835)
-// refused it; with updates every third frame while tracking (the default) the score over δ
-// refuses it first, and the final health (0.81) would as well. (With the scan, the default, this
-// start ends "not converged" too.)
-TEST(Cli, KittiSidePeakIsRefused) {
+// δ started 50 ms off and the δ scan switched off: the local search cannot cross to the true δ.
+// With the folds kept throughout the estimate ended on a side peak about 4° from KITTI's
+// calibration (health 0.81-0.835, refused by the health); with them dropped once acquired (the
+// default) it ends 0.70° off with δ +36.6 ms (KITTI's frames put δ near +6 ms), healthy, and the
+// score over δ, which peaks 14 ms away, refuses it, with an update on every frame and every
+// third. Either way nothing may be claimed. (With the scan, the default, this start ends "not
+// converged" too.)
+TEST(Cli, KittiWrongTimeOffsetIsRefused) {
   STCALIB_REQUIRE_KITTI();
   testing::ScopedTempDir tmp;
   for (const std::string every : {"1", "3"}) {
@@ -701,13 +694,15 @@ TEST(Cli, KittiSidePeakIsRefused) {
                                        "--tracking_update_every=" +
                                            every);
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_THAT(r.output, HasSubstr("not converged: "));
     const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
-    EXPECT_GT(result["agreement_with_drive_calibration"]["rotation_deg"].get<double>(), 3.0);
-    EXPECT_LT(result["health"].get<double>(), 0.9) << r.output;
+    // The estimate is wrong: far off in rotation or in δ.
+    const nlohmann::json& agreement = result["agreement_with_drive_calibration"];
+    EXPECT_TRUE(agreement["rotation_deg"].get<double>() > 0.5 ||
+                std::abs(result["time_offset_s"].get<double>()) > 0.02)
+        << r.output;
+    EXPECT_FALSE(result["converged"].get<bool>());
     EXPECT_FALSE(std::filesystem::exists(out + "/calib_velo_to_cam.txt"));
-    EXPECT_THAT(r.output, HasSubstr(every == "1" ? "not converged: health"
-                                                 : "not converged: the last frames' score over δ"));
+    EXPECT_THAT(r.output, HasSubstr("not converged: the last frames' score over δ"));
   }
 }
 

@@ -103,24 +103,29 @@ struct OnlineCalibratorOptions {
   // profiles do not). Whatever the choice, the health (a frame's, the lost test's, the verdict's
   // final health) reads every point: see HealthWindow. (kDrop was measured below before that.)
   // Folds bias the vertical translation (2-5 cm on simulated drives) and KITTI's roll, but
-  // the first frames' search needs them. Measured (scripts/sweep, 30 runs; 40-frame simulated
-  // drives, seeds 1-6), against kKeep:
-  //  - kDropWhenTracking: the frame the folds are first dropped on updates at once and by a full
-  //    step (the acquired translation carries the folds' bias: without that step, a 16-frame
-  //    simulated drive with refine_frames 10 ended 0.35° from the truth, its polish refining the
-  //    rotation into that bias; with it 0.10°, kKeep 0.14°). KITTI ends within 0.2° of its
-  //    calibration on 12 of 16 starts (2; mean 0.171° against 0.262°), fifth frame alike (10 of
-  //    16); 20-frame simulated drives unchanged (their acquisition ends on the last frame);
-  //    40-frame ones within 3 cm on 5 of 6 (3 of 6) but rotation worse (mean 0.138° against
-  //    0.113°; 0.255° on one, roll drifting 0.2° over the fold-free updates); 20-frame ones with
-  //    refine_frames 10 within 0.1° on 6 of 13 (4 of 13) but 0.26° and 0.30° on two (0.15° kept),
-  //    roll again. Folds carry roll: not the default.
+  // the first frames' search needs them: kDropWhenTracking, the default, keeps them for the
+  // acquisition only. The frame they are first dropped on updates at once and by a full step
+  // (the acquired translation carries the folds' bias: without that step, a 16-frame simulated
+  // drive with refine_frames 10 ended 0.35° from the truth, its polish refining the rotation
+  // into that bias; with it 0.10°, kKeep 0.14°). Measured against kKeep:
+  //  - scripts/sweep (30 runs): KITTI ends within 0.2° of its calibration on 12 of 16 starts
+  //    (kKeep 2; mean 0.171° against 0.262°), fifth frame alike (10 of 16); the 20-frame
+  //    simulated drives are unchanged (their acquisition ends on their last frame).
+  //  - 40-frame simulated drives, seeds 1-12 (δ +30 ms, 6 movers, ±2°/±5 cm): rotation mean
+  //    0.110° (kKeep 0.125°), within 3 cm on 11 of 12 (4). Fold-free tracking lets roll drift on
+  //    some (seed 1: 0.255°, kKeep 0.071°; its turn, frames 16-27, pulls roll 0.3-0.6° off even
+  //    from the truth and with the folds kept), kKeep's vertical bias others (seed 12: 0.302°
+  //    and 5.7 cm, here 0.112° and 2.4 cm).
+  //  - With refine_frames 10 (scripts/sweep): simulated rotation mean 0.153° (kKeep 0.197°), 6
+  //    of 14 within 0.1° (4); KITTI 0 of 16 within 0.2° either way, 15 of 16 converged (16).
   //  - kDrop: KITTI's fifth frame within 0.3° on 4 of 16, and one start claimed 0.52° and 8 cm.
+  //  - Ending the acquisition on fewer frames than refine_frames (14, 10), so that 20-frame
+  //    drives also track without folds, made both worse (simulated within 0.1° on 6 of 14).
   // kDropWhenTracking without the grid's acquisition (acquire_with_grid off, lost_grid_deg 0)
   // keeps them: there is no acquisition to end. Once dropped, they stay out of every later
   // window, a lost estimate's grid and search included.
   enum class Folds { kKeep, kDrop, kDropWhenTracking };
-  Folds folds = Folds::kKeep;
+  Folds folds = Folds::kDropWhenTracking;
 
   // Whether the search reads the frames' coarse score levels (their pyramid): only without the
   // rotation grid (lost_grid_deg = 0), where a lost or filling window searches coarse to fine.
