@@ -115,7 +115,9 @@ struct OnlineCalibratorOptions {
   //    0.110° (kKeep 0.125°), within 3 cm on 11 of 12 (4). Fold-free tracking lets roll drift on
   //    some (seed 1: 0.255°, kKeep 0.071°; its turn, frames 16-27, pulls roll 0.3-0.6° off even
   //    from the truth and with the folds kept), kKeep's vertical bias others (seed 12: 0.302°
-  //    and 5.7 cm, here 0.112° and 2.4 cm).
+  //    and 5.7 cm, here 0.112° and 2.4 cm). Other cameras, 40 frames: hd720 seeds 1 and 3 0.273°
+  //    and 0.126° (kKeep 0.125°, 0.123°), kitti_1003 seeds 2 and 4 0.053° and 0.095° (0.142°,
+  //    0.094°); within 3 cm on 4 of 4 (2).
   //  - With refine_frames 10 (scripts/sweep): simulated rotation mean 0.153° (kKeep 0.197°), 6
   //    of 14 within 0.1° (4); KITTI 0 of 16 within 0.2° either way, 15 of 16 converged (16).
   //  - kDrop: KITTI's fifth frame within 0.3° on 4 of 16, and one start claimed 0.52° and 8 cm.
