@@ -111,6 +111,7 @@ CalibrateJob CalibrateJobFromFlags() {
   o.point_margin = FLAGS_point_margin;
   ParseFolds(FLAGS_lidar_folds, &o.folds);
   o.horizontal_weight = FLAGS_horizontal_weight;
+  o.tracking_horizontal_weight = FLAGS_tracking_horizontal_weight;
   o.search.alpha1_rotation_deg = FLAGS_alpha1_rotation_deg;
   o.search.alpha2_translation_m = FLAGS_alpha2_translation_m;
   o.search.alpha3_rotation_deg = FLAGS_alpha3_rotation_deg;

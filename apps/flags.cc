@@ -54,6 +54,9 @@ DEFINE_string(loss, "cauchy", "calibrate: robust loss, cauchy | huber");
 DEFINE_double(loss_scale_px, kOnline.refine.loss_scale_px, "calibrate: robust-loss scale [px]");
 DEFINE_double(horizontal_weight, kOnline.horizontal_weight,
               "calibrate: weight w of horizontal edges (vertical: 1 - w)");
+DEFINE_double(tracking_horizontal_weight, kOnline.tracking_horizontal_weight,
+              "calibrate: w once the folds are dropped (--lidar_folds=drop_when_tracking, after "
+              "the acquisition)");
 DEFINE_double(alpha1_rotation_deg, kOnline.search.alpha1_rotation_deg,
               "search: large rotation step [deg]");
 DEFINE_double(alpha2_translation_m, kOnline.search.alpha2_translation_m,

@@ -30,6 +30,7 @@ DECLARE_bool(estimate_time_offset);
 DECLARE_string(loss);
 DECLARE_double(loss_scale_px);
 DECLARE_double(horizontal_weight);
+DECLARE_double(tracking_horizontal_weight);
 DECLARE_double(alpha1_rotation_deg);
 DECLARE_double(alpha2_translation_m);
 DECLARE_double(alpha3_rotation_deg);

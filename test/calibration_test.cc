@@ -459,7 +459,13 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     SCOPED_TRACE("frame " + std::to_string(report.frame) + ": " + report.reason);
     EXPECT_EQ(folds_read(dropping), 0u);
     EXPECT_GT(count_folds(dropping.HealthWindow()), 0u);
-    WindowScorer health_scorer(dropping.HealthWindow(), dropping.options().score);
+    // From then on every window is read at tracking_horizontal_weight, the health's too.
+    ASSERT_NE(dropping_options.tracking_horizontal_weight, dropping.options().horizontal_weight);
+    EXPECT_EQ(dropping.ScoreOptionsInUse().horizontal_weight,
+              dropping_options.tracking_horizontal_weight);
+    EXPECT_EQ(dropping.RefineOptionsInUse().horizontal_weight,
+              dropping_options.tracking_horizontal_weight);
+    WindowScorer health_scorer(dropping.HealthWindow(), dropping.ScoreOptionsInUse());
     EXPECT_EQ(report.health, HealthScore(&health_scorer, dropping.state()));
     const bool first = dropped_frames++ == 0;
     EXPECT_EQ(report.reason.find("folds dropped, a full step") == 0,
@@ -477,6 +483,8 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     last = calibrator.AddFrame(frames[k]);
     const FrameReport dropped = dropping.AddFrame(frames[k]);
     if (dropped.acquiring) {  // acquiring when the frame arrived: the default's frames
+      EXPECT_EQ(dropping.ScoreOptionsInUse().horizontal_weight,
+                dropping.options().horizontal_weight);
       folds_while_acquiring += folds_read(dropping);
       EXPECT_EQ(folds_read(dropping), folds_read(calibrator)) << "frame " << k;
       EXPECT_TRUE(dropping.state().T_camera_lidar.matrix() ==

@@ -46,8 +46,10 @@ Status OnlineCalibratorOptions::Validate() const {
   if (tracking_update_every < 1) {
     return Status::Error("online: tracking_update_every must be >= 1");
   }
-  if (!(horizontal_weight >= 0 && horizontal_weight <= 1)) {
-    return Status::Error("online: horizontal_weight must be in [0, 1]");
+  if (!(horizontal_weight >= 0 && horizontal_weight <= 1) ||
+      !(tracking_horizontal_weight >= 0 && tracking_horizontal_weight <= 1)) {
+    return Status::Error(
+        "online: horizontal_weight and tracking_horizontal_weight must be in [0, 1]");
   }
   STCALIB_RETURN_IF_ERROR(search.Validate());
   return refine.Validate();
@@ -104,6 +106,10 @@ OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
       std::clamp(state_.time_offset_s, -options_.time_offset_bound_s, options_.time_offset_bound_s);
   anchor_ = state_;
   frames_since_update_ = options_.tracking_update_every;
+  tracking_score_ = options_.score;
+  tracking_score_.horizontal_weight = options_.tracking_horizontal_weight;
+  tracking_refine_ = options_.refine;
+  tracking_refine_.horizontal_weight = options_.tracking_horizontal_weight;
 }
 
 const std::shared_ptr<const CalibrationFrame>& OnlineCalibrator::InUse(
@@ -131,7 +137,7 @@ WindowScorer* OnlineCalibrator::HealthScorer(const std::vector<const Calibration
                                              std::optional<WindowScorer>* own) const {
   const std::vector<const CalibrationFrame*> health_window = HealthWindow();
   if (health_window == window) return scorer;
-  own->emplace(health_window, options_.score);
+  own->emplace(health_window, ScoreOptionsInUse());
   return &**own;
 }
 
@@ -211,7 +217,7 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
                     "): estimate kept";
     return report;
   }
-  WindowScorer scorer(frames, options_.score);
+  WindowScorer scorer(frames, ScoreOptionsInUse());
   report.score_before = scorer.Evaluate(state_, -1);
   report.gray_rate_before = scorer.GrayRate(state_);
   // The health reads every point, folds included (see HealthWindow).
@@ -241,13 +247,13 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
                           static_cast<int>(frames.size()) < options_.window_frames);
   const std::vector<const CalibrationFrame*> refine_frames = RefineWindow();
   // The refinement's frames: the grid's window and the judge of the candidates.
-  WindowScorer long_scorer(refine_frames, options_.score);
+  WindowScorer long_scorer(refine_frames, ScoreOptionsInUse());
   AdaptiveGridSearchOptions search_options = options_.search;
   Search(&scorer, &long_scorer, &search_options, &report);
 
   const auto start = std::chrono::steady_clock::now();
-  report.refine =
-      Refine(refine_frames, report.search.state, report.search.state, anchor_, options_.refine);
+  report.refine = Refine(refine_frames, report.search.state, report.search.state, anchor_,
+                         RefineOptionsInUse());
   report.refine_ms = MillisecondsSince(start);
 
   Choose(Candidates(&scorer, search_options, &report), &long_scorer, search_options, refit,
@@ -272,7 +278,7 @@ FrameReport OnlineCalibrator::Polish() {
   }
   const auto start = std::chrono::steady_clock::now();
   // Rotation, δ and the translation along the direction of travel (see the header).
-  RefineOptions refine_options = options_.refine;
+  RefineOptions refine_options = RefineOptionsInUse();
   refine_options.translation = RefineOptions::Translation::kAlongTravel;
   refine_options.place_at_time_offset = true;
   report.refine = Refine(frames, state_, state_, anchor_, refine_options);
@@ -322,7 +328,7 @@ FrameReport OnlineCalibrator::Polish() {
   report.reason = "polish: refined over " + std::to_string(frames.size()) + " frames" + pair_text;
   // On the search window (the health on HealthWindow), like a frame's.
   const std::vector<const CalibrationFrame*> window = SearchWindow();
-  WindowScorer scorer(window, options_.score);
+  WindowScorer scorer(window, ScoreOptionsInUse());
   std::optional<WindowScorer> own_health_scorer;
   MeasureEstimate(&scorer, HealthScorer(window, &scorer, &own_health_scorer), true, &report);
   return report;
