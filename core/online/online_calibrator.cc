@@ -106,10 +106,9 @@ OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
       std::clamp(state_.time_offset_s, -options_.time_offset_bound_s, options_.time_offset_bound_s);
   anchor_ = state_;
   frames_since_update_ = options_.tracking_update_every;
-  tracking_score_ = options_.score;
-  tracking_score_.horizontal_weight = options_.tracking_horizontal_weight;
-  tracking_refine_ = options_.refine;
-  tracking_refine_.horizontal_weight = options_.tracking_horizontal_weight;
+  OnlineCalibratorOptions fold_free = options_;
+  fold_free.horizontal_weight = options_.tracking_horizontal_weight;
+  fold_free_options_ = WithSharedSettings(fold_free);
 }
 
 const std::shared_ptr<const CalibrationFrame>& OnlineCalibrator::InUse(

@@ -263,10 +263,10 @@ class OnlineCalibrator {
   // The score's and the refinement's options as the calibrator reads them now: with the folds
   // dropped, at tracking_horizontal_weight.
   const ScoreOptions& ScoreOptionsInUse() const {
-    return folds_dropped_ ? tracking_score_ : options_.score;
+    return (folds_dropped_ ? fold_free_options_ : options_).score;
   }
   const RefineOptions& RefineOptionsInUse() const {
-    return folds_dropped_ ? tracking_refine_ : options_.refine;
+    return (folds_dropped_ ? fold_free_options_ : options_).refine;
   }
 
  private:
@@ -313,12 +313,13 @@ class OnlineCalibrator {
 
   OnlineCalibratorOptions options_;
   CalibrationState state_;
-  CalibrationState anchor_;        ///< the initial calibration: the search's bounds are around it
-  bool acquiring_ = true;          ///< see OnlineCalibratorOptions::acquire_with_grid
-  bool folds_dropped_ = false;     ///< OnlineCalibratorOptions::Folds::kDropWhenTracking in effect
-  ScoreOptions tracking_score_;    ///< options_.score at tracking_horizontal_weight
-  RefineOptions tracking_refine_;  ///< options_.refine at tracking_horizontal_weight
-  bool refit_pending_ = false;     ///< the first update without the folds has not run yet
+  CalibrationState anchor_;     ///< the initial calibration: the search's bounds are around it
+  bool acquiring_ = true;       ///< see OnlineCalibratorOptions::acquire_with_grid
+  bool folds_dropped_ = false;  ///< OnlineCalibratorOptions::Folds::kDropWhenTracking in effect
+  // options_ with horizontal_weight at tracking_horizontal_weight, shared into score and refine
+  // by WithSharedSettings: what the calibrator reads once the folds are dropped.
+  OnlineCalibratorOptions fold_free_options_;
+  bool refit_pending_ = false;  ///< the first update without the folds has not run yet
   // The latest estimate whose health reached lost_health after a full window: when the estimate
   // is lost, a search from there is a candidate too (a disturbance or a wrong jump).
   bool has_last_healthy_ = false;
