@@ -82,8 +82,9 @@ Status LidarEdgeOptions::Validate() const {
   if (!(min_range_m >= 0 && max_range_m > min_range_m)) {
     return Status::Error("lidar edges: need 0 <= min_range_m < max_range_m");
   }
-  if (!(fold_height_tolerance_m >= 0) || !(fold_max_depth_m >= 0)) {
-    return Status::Error("lidar edges: fold_height_tolerance_m and fold_max_depth_m must be >= 0");
+  if (!(fold_height_tolerance_m >= 0) || !(fold_max_depth_m >= 0) || !(fold_top_depth_m >= 0)) {
+    return Status::Error(
+        "lidar edges: fold_height_tolerance_m, fold_max_depth_m and fold_top_depth_m must be >= 0");
   }
   if (!(jump_min_m > 0) || jump_per_range < 0 || !(smooth_tolerance_m > 0) ||
       smooth_per_range < 0 || smooth_neighbours < 0 || !(max_gap_steps >= 1)) {
@@ -237,6 +238,38 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
       if (usage(j) != PointUse::kUse) return std::numeric_limits<float>::quiet_NaN();
       return rings.range_m[j];
     };
+    // Direction of the ring `dir` steps from i's in elevation order, at i's azimuth (where a
+    // missing return would have been); zero when there is no such ring.
+    auto ring_direction = [&](int i, int dir) -> Eigen::Vector3d {
+      const int rank = rings.elevation_rank[rings.ring[i]] + dir;
+      if (rank < 0 || rank >= rings.num_rings()) return Eigen::Vector3d::Zero();
+      const double elevation = rings.ring_elevation_rad[rings.order_by_elevation[rank]];
+      const double azimuth = rings.azimuth_rad[i];
+      return Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                             std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+    };
+    // A fold's top (LidarEdgeOptions::fold_top_depth_m): from `top`, the return of the beam
+    // above the corner, up the beams that land on it at its height. Returns the last of them
+    // and, in `beyond`, the direction of the beam above it (its return, or where it would be);
+    // −1 when the walk meets an edge point: the top's far side is one already.
+    auto far_side_of_top = [&](int top, Eigen::Vector3d *beyond) {
+      for (;;) {
+        if (is_edge[top]) return -1;
+        int above = -1;
+        const float range = vertical_neighbour(top, -1, &above);
+        if (above >= 0 && std::isfinite(range) &&
+            range - rings.range_m[top] < options.fold_top_depth_m &&
+            std::abs(scan.points_lidar[above].z() - scan.points_lidar[top].z()) <
+                options.fold_height_tolerance_m) {
+          top = above;
+          continue;
+        }
+        *beyond =
+            above >= 0 && !std::isnan(range) ? scan.points_lidar[above] : ring_direction(top, -1);
+        return top;
+      }
+    };
+    std::vector<int> tops;  // the tops' first returns of the folds to move, after the edges
     for (size_t i = 0; i < scan.size(); ++i) {
       if (is_edge[i] || usage(i) != PointUse::kUse) continue;
       const float r = rings.range_m[i];
@@ -247,28 +280,29 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
         if (std::isnan(other) || other - r < jump(r)) continue;
         const float next = vertical_neighbour(static_cast<int>(i), -dir, &unused);
         if (std::isfinite(next) && std::abs(next - r) < smooth(r)) {
-          Eigen::Vector3d far_direction = Eigen::Vector3d::Zero();
-          if (far >= 0) {
-            far_direction = scan.points_lidar[far];
-          } else {  // no return (sky): the adjacent ring's elevation, same azimuth
-            const int rank = rings.elevation_rank[rings.ring[i]] + dir;
-            if (rank >= 0 && rank < rings.num_rings()) {
-              const double elevation = rings.ring_elevation_rad[rings.order_by_elevation[rank]];
-              const double azimuth = rings.azimuth_rad[i];
-              far_direction =
-                  Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
-                                  std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
-            }
-          }
+          // No return (sky): the adjacent ring's elevation, same azimuth.
+          Eigen::Vector3d far_direction =
+              far >= 0 ? scan.points_lidar[far] : ring_direction(static_cast<int>(i), dir);
           // The beam above (dir −1 in elevation order) on the same height, below the sensor.
           const double z = scan.points_lidar[i].z();
           const bool fold =
               dir < 0 && far >= 0 && z < 0 && other - r < options.fold_max_depth_m &&
               std::abs(scan.points_lidar[far].z() - z) < options.fold_height_tolerance_m;
+          if (fold && other - r < options.fold_top_depth_m) {
+            is_edge[i] = 1;  // the corner is not the outline: the top's far side is
+            tops.push_back(far);
+            break;
+          }
           add(static_cast<int>(i), EdgeKind::kHorizontal, far_direction, fold);
           break;
         }
       }
+    }
+    // Moved once every other edge is known, so that the result does not depend on scan order.
+    for (int first : tops) {
+      Eigen::Vector3d beyond;
+      const int top = far_side_of_top(first, &beyond);
+      if (top >= 0) add(top, EdgeKind::kHorizontal, beyond, true);
     }
   };
   if (options.horizontal_edges && rings.num_rings() >= 3) AddHorizontal();
