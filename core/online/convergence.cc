@@ -17,11 +17,13 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   verdict.estimate = calibrator.state();
 
   // Aliasing guard over δ and the rotation-axis profiles, on the refinement's frames (the
-  // longest window the calibrator keeps: a sharp score's profile over 3 frames is noisy).
+  // longest window the calibrator keeps: a sharp score's profile over 3 frames is noisy), scored
+  // as the calibrator scores them now (ScoreOptionsInUse: the tracking weight once the folds are
+  // dropped).
   const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
   std::vector<const CalibrationFrame*> profile_frames;
   for (const auto& frame : recent) profile_frames.push_back(frame.get());
-  WindowScorer scorer(profile_frames, calibrator.options().score);
+  WindowScorer scorer(profile_frames, calibrator.ScoreOptionsInUse());
   verdict.time_offset_profile =
       ProfileTimeOffset(&scorer, verdict.estimate, online.time_offset_bound_s, 0.0025);
   for (int axis = 0; axis < 3; ++axis) {
