@@ -7,7 +7,8 @@
 #include <limits>
 #include <memory>
 #include <numeric>
-#include <unordered_map>
+#include <utility>
+#include <vector>
 
 #include "core/features/kdtree.h"
 
@@ -142,6 +143,63 @@ class RangeImage {
   std::vector<float> range_;
 };
 
+// Voxel key → index, open addressing with linear probing: one flat array instead of a node per
+// key (std::unordered_map's allocations were most of the filter's own time). Keys are
+// non-negative (VoxelKey packs three 21-bit fields).
+class VoxelIndex {
+ public:
+  explicit VoxelIndex(size_t expected) { Rehash(std::max<size_t>(64, 2 * expected)); }
+  // The value stored for `key`, inserting `value` when absent; `inserted` says which.
+  int Emplace(int64_t key, int value, bool* inserted = nullptr) {
+    if (2 * (size_ + 1) > keys_.size()) Rehash(2 * keys_.size());
+    size_t slot = Slot(key);
+    while (keys_[slot] != kEmpty && keys_[slot] != key) slot = (slot + 1) & mask_;
+    const bool added = keys_[slot] == kEmpty;
+    if (added) {
+      keys_[slot] = key;
+      values_[slot] = value;
+      ++size_;
+    }
+    if (inserted != nullptr) *inserted = added;
+    return values_[slot];
+  }
+  // The value stored for `key`, or −1.
+  int Find(int64_t key) const {
+    for (size_t slot = Slot(key); keys_[slot] != kEmpty; slot = (slot + 1) & mask_) {
+      if (keys_[slot] == key) return values_[slot];
+    }
+    return -1;
+  }
+
+ private:
+  static constexpr int64_t kEmpty = -1;
+  size_t Slot(int64_t key) const {
+    return static_cast<size_t>((static_cast<uint64_t>(key) * 0x9E3779B97F4A7C15ull) >> shift_);
+  }
+  void Rehash(size_t capacity) {
+    size_t pow2 = 64;
+    int bits = 6;
+    while (pow2 < capacity) {
+      pow2 *= 2;
+      ++bits;
+    }
+    std::vector<int64_t> keys = std::move(keys_);
+    std::vector<int> values = std::move(values_);
+    keys_.assign(pow2, kEmpty);
+    values_.assign(pow2, 0);
+    mask_ = pow2 - 1;
+    shift_ = 64 - bits;
+    size_ = 0;
+    for (size_t i = 0; i < keys.size(); ++i) {
+      if (keys[i] != kEmpty) Emplace(keys[i], values[i]);
+    }
+  }
+  std::vector<int64_t> keys_;
+  std::vector<int> values_;
+  size_t mask_ = 0, size_ = 0;
+  int shift_ = 58;
+};
+
 int64_t VoxelKey(const Eigen::Vector3d& p, double cell) {
   const int64_t x = static_cast<int64_t>(std::floor(p.x() / cell));
   const int64_t y = static_cast<int64_t>(std::floor(p.y() / cell));
@@ -166,7 +224,7 @@ void FlagAgainst(const std::vector<Eigen::Vector3d>& current, const std::vector<
   const std::vector<Eigen::Vector3d>& own = *reference.points;
   std::vector<Eigen::Vector3d> moved;
   moved.reserve(own.size() / 2);
-  std::unordered_map<int64_t, char> occupied;
+  VoxelIndex occupied(options.reference_voxel_m > 0 ? own.size() / 2 : 0);
   const double max_r2 = (options.max_range_m + 5.0) * (options.max_range_m + 5.0);
   bool any_in_range = false;  // a reference to compare with at all
   for (size_t i = 0; i < own.size(); ++i) {
@@ -175,9 +233,10 @@ void FlagAgainst(const std::vector<Eigen::Vector3d>& current, const std::vector<
     const Eigen::Vector3d p = reference.T_current_reference * own[i];
     if (p.squaredNorm() > max_r2) continue;
     any_in_range = true;
-    if (options.reference_voxel_m > 0 &&
-        !occupied.emplace(VoxelKey(p, options.reference_voxel_m), 1).second) {
-      continue;
+    if (options.reference_voxel_m > 0) {
+      bool inserted = false;
+      occupied.Emplace(VoxelKey(p, options.reference_voxel_m), 1, &inserted);
+      if (!inserted) continue;
     }
     if (!reach.Reaches(p)) continue;
     moved.push_back(p);
@@ -241,8 +300,7 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
   auto key = [](int64_t x, int64_t y, int64_t z) {
     return (x & 0x1FFFFF) | ((y & 0x1FFFFF) << 21) | ((z & 0x1FFFFF) << 42);
   };
-  std::unordered_map<int64_t, int> voxel_id;
-  voxel_id.reserve(selected.size() / 2);
+  VoxelIndex voxel_id(selected.size() / 2);
   std::vector<Eigen::Vector3i> voxels;
   std::vector<int> point_voxel(selected.size());
   for (size_t k = 0; k < selected.size(); ++k) {
@@ -250,10 +308,10 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
     const Eigen::Vector3i v(static_cast<int>(std::floor(p.x() / cell)),
                             static_cast<int>(std::floor(p.y() / cell)),
                             static_cast<int>(std::floor(p.z() / cell)));
-    auto [it, inserted] =
-        voxel_id.emplace(key(v.x(), v.y(), v.z()), static_cast<int>(voxels.size()));
+    bool inserted = false;
+    point_voxel[k] =
+        voxel_id.Emplace(key(v.x(), v.y(), v.z()), static_cast<int>(voxels.size()), &inserted);
     if (inserted) voxels.push_back(v);
-    point_voxel[k] = it->second;
   }
   std::vector<int> parent(voxels.size());
   std::iota(parent.begin(), parent.end(), 0);
@@ -262,9 +320,9 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = voxel_id.find(key(v.x() + dx, v.y() + dy, v.z() + dz));
-          if (it == voxel_id.end()) continue;
-          const int ra = Find(parent, static_cast<int>(a)), rb = Find(parent, it->second);
+          const int b = voxel_id.Find(key(v.x() + dx, v.y() + dy, v.z() + dz));
+          if (b < 0) continue;
+          const int ra = Find(parent, static_cast<int>(a)), rb = Find(parent, b);
           if (ra != rb) parent[ra] = rb;
         }
       }
@@ -301,13 +359,11 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
   // Points sharing a query voxel share one nearest-neighbour query.
   std::vector<int> representative(selected.size());
   {
-    std::unordered_map<int64_t, int> first;
-    first.reserve(selected.size());
+    VoxelIndex first(selected.size());
     for (size_t k = 0; k < selected.size(); ++k) {
       const double query_cell = options.query_voxel_m > 0 ? options.query_voxel_m : 1e-6;
       representative[k] =
-          first.emplace(VoxelKey(current[selected[k]], query_cell), static_cast<int>(k))
-              .first->second;
+          first.Emplace(VoxelKey(current[selected[k]], query_cell), static_cast<int>(k));
     }
   }
   // Where the queries can find a neighbour within τ: cells at least τ_max wide, dilated by one.
