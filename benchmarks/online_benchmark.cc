@@ -4,6 +4,8 @@
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <opencv2/core.hpp>
 
 #include "core/online/frame_source.h"
@@ -20,6 +22,11 @@ FrameSourceOptions CalibrateSourceOptions() {
   if (!OnlineCalibratorOptions().ReadsCoarseLevels()) options.image.pyramid_basins_px.clear();
   return options;
 }
+
+// A new frame source (its sweep cache empty) that has loaded frames [0, n), each handed to
+// `use` (may be empty): the untimed start of a benchmark cycle over later frames.
+Status StartCycle(size_t n, const std::function<void(std::shared_ptr<CalibrationFrame>)>& use,
+                  std::unique_ptr<DriveFrameSource>* source);
 
 struct Fixture {
   Drive drive;
@@ -194,15 +201,12 @@ void BM_WholeFrame(benchmark::State& state) {
   for (auto _ : state) {
     if (next == Kitti().drive.NumFrames()) {
       state.PauseTiming();
-      if (!DriveFrameSource::Create(&Kitti().drive, CalibrateSourceOptions(), &source).ok()) {
-        return state.SkipWithError("frame source");
-      }
       calibrator = std::make_unique<OnlineCalibrator>(options, KittiCalibration());
-      for (next = 0; next < kFirstTimed; ++next) {
-        auto frame = std::make_shared<CalibrationFrame>();
-        if (!source->Load(next, frame.get()).ok()) return state.SkipWithError("load");
-        calibrator->AddFrame(frame);
-      }
+      const Status started = StartCycle(
+          kFirstTimed, [&](std::shared_ptr<CalibrationFrame> f) { calibrator->AddFrame(f); },
+          &source);
+      if (!started.ok()) return state.SkipWithError(started.message().c_str());
+      next = kFirstTimed;
       state.ResumeTiming();
     }
     auto frame = std::make_shared<CalibrationFrame>();
@@ -219,6 +223,18 @@ void BM_WholeFrame(benchmark::State& state) {
 // Arg: tracking_update_every (3, the default; 1, an update on every frame).
 BENCHMARK(BM_WholeFrame)->Arg(3)->Arg(1)->Unit(benchmark::kMillisecond);
 
+Status StartCycle(size_t n, const std::function<void(std::shared_ptr<CalibrationFrame>)>& use,
+                  std::unique_ptr<DriveFrameSource>* source) {
+  STCALIB_RETURN_IF_ERROR(
+      DriveFrameSource::Create(&Kitti().drive, CalibrateSourceOptions(), source));
+  for (size_t i = 0; i < n; ++i) {
+    auto frame = std::make_shared<CalibrationFrame>();
+    STCALIB_RETURN_IF_ERROR((*source)->Load(i, frame.get()));
+    if (use) use(frame);
+  }
+  return Status::Ok();
+}
+
 // Image features, LiDAR features and local map for each new frame of frames 12-29, the sweeps
 // before it cached as in a run: each cycle starts a new frame source and loads frames 0-11
 // untimed (see BM_WholeFrame on why one source cannot cycle).
@@ -230,13 +246,9 @@ void BM_FrameFeatures(benchmark::State& state) {
   for (auto _ : state) {
     if (frame == Kitti().drive.NumFrames()) {
       state.PauseTiming();
-      if (!DriveFrameSource::Create(&Kitti().drive, CalibrateSourceOptions(), &source).ok()) {
-        return state.SkipWithError("frame source");
-      }
-      for (frame = 0; frame < kFirstTimed; ++frame) {
-        CalibrationFrame f;
-        if (!source->Load(frame, &f).ok()) return state.SkipWithError("load");
-      }
+      const Status started = StartCycle(kFirstTimed, {}, &source);
+      if (!started.ok()) return state.SkipWithError(started.message().c_str());
+      frame = kFirstTimed;
       state.ResumeTiming();
     }
     CalibrationFrame f;

@@ -479,8 +479,8 @@ TEST(LidarEdges, FoldsMovedToTheFarSideOfTheirTopLieOnItsOutline) {
   corner_options.fold_top_depth_m = 0;
   struct Errors {
     double sum = 0, abs_sum = 0;
-    size_t count = 0;
     std::vector<double> all;
+    size_t count() const { return all.size(); }
   } moved, corners;
   ForEachSimulatedSweep([&](const Simulator& s, uint64_t, int frame,
                             const sim::SimulatedSweep& sweep) {
@@ -533,23 +533,22 @@ TEST(LidarEdges, FoldsMovedToTheFarSideOfTheirTopLieOnItsOutline) {
         errors.sum += error_deg;
         errors.abs_sum += std::abs(error_deg);
         errors.all.push_back(error_deg);
-        ++errors.count;
       }
     }
   });
-  ASSERT_GT(moved.count, 20u);
-  ASSERT_GT(corners.count, 20u);
+  ASSERT_GT(moved.count(), 20u);
+  ASSERT_GT(corners.count(), 20u);
   for (auto* e : {&moved, &corners}) std::sort(e->all.begin(), e->all.end());
   auto quartiles = [](const Errors& e) {
-    return std::to_string(e.all[e.count / 4]) + ".." + std::to_string(e.all[3 * e.count / 4]);
+    return std::to_string(e.all[e.count() / 4]) + ".." + std::to_string(e.all[3 * e.count() / 4]);
   };
-  const double moved_mean = moved.sum / moved.count, moved_abs = moved.abs_sum / moved.count;
-  const double corner_mean = corners.sum / corners.count;
-  const double corner_abs = corners.abs_sum / corners.count;
+  const double moved_mean = moved.sum / moved.count(), moved_abs = moved.abs_sum / moved.count();
+  const double corner_mean = corners.sum / corners.count();
+  const double corner_abs = corners.abs_sum / corners.count();
   std::printf(
       "%zu folds moved: elevation error mean %+.3f deg, |error| %.3f deg, quartiles %s; %zu at "
       "corners: %+.3f deg, %.3f deg, %s\n",
-      moved.count, moved_mean, moved_abs, quartiles(moved).c_str(), corners.count, corner_mean,
+      moved.count(), moved_mean, moved_abs, quartiles(moved).c_str(), corners.count(), corner_mean,
       corner_abs, quartiles(corners).c_str());
   EXPECT_LT(std::abs(moved_mean), 0.1);
   EXPECT_LT(moved_abs, 0.2);

@@ -145,7 +145,7 @@ class RangeImage {
 
 // Voxel key → index, open addressing with linear probing: one flat array instead of a node per
 // key (std::unordered_map's allocations were most of the filter's own time). Keys are
-// non-negative (VoxelKey packs three 21-bit fields).
+// non-negative (PackVoxel).
 class VoxelIndex {
  public:
   explicit VoxelIndex(size_t expected) { Rehash(std::max<size_t>(64, 2 * expected)); }
@@ -200,11 +200,15 @@ class VoxelIndex {
   int shift_ = 58;
 };
 
-int64_t VoxelKey(const Eigen::Vector3d& p, double cell) {
-  const int64_t x = static_cast<int64_t>(std::floor(p.x() / cell));
-  const int64_t y = static_cast<int64_t>(std::floor(p.y() / cell));
-  const int64_t z = static_cast<int64_t>(std::floor(p.z() / cell));
+// Integer voxel coordinates packed into one non-negative key, 21 bits each.
+int64_t PackVoxel(int64_t x, int64_t y, int64_t z) {
   return (x & 0x1FFFFF) | ((y & 0x1FFFFF) << 21) | ((z & 0x1FFFFF) << 42);
+}
+
+int64_t VoxelKey(const Eigen::Vector3d& p, double cell) {
+  return PackVoxel(static_cast<int64_t>(std::floor(p.x() / cell)),
+                   static_cast<int64_t>(std::floor(p.y() / cell)),
+                   static_cast<int64_t>(std::floor(p.z() / cell)));
 }
 
 // τ(r), widened by the reference voxel's half diagonal [m].
@@ -297,9 +301,6 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
 
   // Euclidean clustering on a voxel grid: occupied voxels touching (26-neighbourhood) join.
   const double cell = options.cluster_tolerance_m;
-  auto key = [](int64_t x, int64_t y, int64_t z) {
-    return (x & 0x1FFFFF) | ((y & 0x1FFFFF) << 21) | ((z & 0x1FFFFF) << 42);
-  };
   VoxelIndex voxel_id(selected.size() / 2);
   std::vector<Eigen::Vector3i> voxels;
   std::vector<int> point_voxel(selected.size());
@@ -309,8 +310,8 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
                             static_cast<int>(std::floor(p.y() / cell)),
                             static_cast<int>(std::floor(p.z() / cell)));
     bool inserted = false;
-    point_voxel[k] =
-        voxel_id.Emplace(key(v.x(), v.y(), v.z()), static_cast<int>(voxels.size()), &inserted);
+    point_voxel[k] = voxel_id.Emplace(PackVoxel(v.x(), v.y(), v.z()),
+                                      static_cast<int>(voxels.size()), &inserted);
     if (inserted) voxels.push_back(v);
   }
   std::vector<int> parent(voxels.size());
@@ -322,7 +323,7 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
     for (int dx = 0; dx <= 1; ++dx) {
       for (int dy = dx == 0 ? 0 : -1; dy <= 1; ++dy) {
         for (int dz = dx == 0 && dy == 0 ? 1 : -1; dz <= 1; ++dz) {
-          const int b = voxel_id.Find(key(v.x() + dx, v.y() + dy, v.z() + dz));
+          const int b = voxel_id.Find(PackVoxel(v.x() + dx, v.y() + dy, v.z() + dz));
           if (b < 0) continue;
           const int ra = Find(parent, static_cast<int>(a)), rb = Find(parent, b);
           if (ra != rb) parent[ra] = rb;
