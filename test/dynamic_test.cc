@@ -378,5 +378,48 @@ TEST(LocalMap, KittiMapOfThreeSweepsWithOxtsAndNdt) {
   EXPECT_EQ(oxts_stats.sweeps_used, 1);
 }
 
+// A local map wider than the cache's capacity: the cache grows to hold all its sweeps (it had
+// freed the oldest ones while the map still pointed at them), and a backward pass keeps the
+// cache bounded (it had kept every sweep).
+TEST(SweepCache, HoldsAWideLocalMapAndStaysBoundedOnABackwardPass) {
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  DriveMotion motion;
+  ASSERT_TRUE(DriveMotion::Create(drive, &motion).ok());
+  LocalMapOptions map_options;
+  map_options.sweeps = 10;
+  LidarEdges narrow_map, wide_map;
+  LocalMapStats narrow_stats, wide_stats;
+  SweepCache narrow(drive, motion, LidarFeatureOptions(), /*capacity=*/4);
+  SweepCache wide(drive, motion, LidarFeatureOptions(), /*capacity=*/16);
+  ASSERT_TRUE(narrow.LocalMap(14, map_options, &narrow_map, &narrow_stats).ok());
+  ASSERT_TRUE(wide.LocalMap(14, map_options, &wide_map, &wide_stats).ok());
+  EXPECT_GE(narrow.capacity(), 11u);
+  EXPECT_EQ(narrow_stats.sweeps_used, 10);
+  EXPECT_EQ(wide_stats.sweeps_used, 10);
+  ASSERT_EQ(narrow_map.size(), wide_map.size());
+  ASSERT_GT(wide_map.size(), 0u);
+  double worst_m = 0;
+  for (size_t i = 0; i < wide_map.size(); ++i) {
+    worst_m = std::max(worst_m, (narrow_map.points_lidar[i] - wide_map.points_lidar[i]).norm());
+  }
+  EXPECT_EQ(worst_m, 0.0);
+
+  SweepCache backward(drive, motion, LidarFeatureOptions(), /*capacity=*/4);
+  size_t most = 0;
+  for (size_t frame = 20; frame-- > 0;) {
+    const LidarFrameFeatures* features;
+    ASSERT_TRUE(backward.Finished(frame, &features).ok());
+    EXPECT_GT(features->edges.size(), 0u);
+    most = std::max(most, backward.cached_sweeps());
+  }
+  // Finished sweeps from the one asked for to a capacity after it (capacity + 1); bases also
+  // back to the long-baseline reference, 3 frames at 10 Hz (capacity + 4). Unbounded: 40.
+  EXPECT_LE(most, 2 * backward.capacity() + 5);
+  std::printf("backward pass over 20 sweeps: at most %zu cached (capacity %zu)\n", most,
+              backward.capacity());
+}
+
 }  // namespace
 }  // namespace stcalib

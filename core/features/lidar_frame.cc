@@ -2,6 +2,9 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
+#include <cmath>
+#include <iterator>
 #include <map>
 
 namespace stcalib {
@@ -75,7 +78,19 @@ SweepCache::SweepCache(const Drive& drive, const DriveMotion& motion,
       motion_(motion),
       options_(options),
       sweep_s_(SweepDurationSeconds(drive)),
-      capacity_(std::max<size_t>(capacity, 4)) {}
+      long_gap_(LongBaselineGap(drive, options.dynamic)),
+      // The long-baseline reference stays cached from one frame to the next.
+      capacity_(std::max<size_t>({capacity, 4, long_gap_ + 2})) {}
+
+size_t SweepCache::LongBaselineGap(const Drive& drive, const DynamicFilterOptions& dynamic) {
+  const double period =
+      drive.NumFrames() > 1
+          ? NsToSeconds(drive.lidar_stamps_ns.back() - drive.lidar_stamps_ns.front()) /
+                (drive.NumFrames() - 1)
+          : 0.1;
+  return std::max<size_t>(
+      1, static_cast<size_t>(std::lround(dynamic.long_baseline_s / std::max(period, 1e-3))));
+}
 
 void SweepCache::Evict(size_t newest) {
   while (base_.size() > capacity_ && base_.begin()->first + capacity_ <= newest) {
@@ -83,6 +98,13 @@ void SweepCache::Evict(size_t newest) {
   }
   while (finished_.size() > capacity_ && finished_.begin()->first + capacity_ <= newest) {
     finished_.erase(finished_.begin());
+  }
+}
+
+void SweepCache::EvictNewerThan(size_t last) {
+  while (!base_.empty() && base_.rbegin()->first > last) base_.erase(std::prev(base_.end()));
+  while (!finished_.empty() && finished_.rbegin()->first > last) {
+    finished_.erase(std::prev(finished_.end()));
   }
 }
 
@@ -107,14 +129,7 @@ Status SweepCache::Base(size_t frame, const LidarFrameFeatures** features) {
 Status SweepCache::References(size_t frame, std::vector<ReferenceFeatures>* references) {
   references->clear();
   if (!options_.remove_dynamic || frame == 0) return Status::Ok();
-  const double period =
-      drive_.NumFrames() > 1
-          ? NsToSeconds(drive_.lidar_stamps_ns.back() - drive_.lidar_stamps_ns.front()) /
-                (drive_.NumFrames() - 1)
-          : 0.1;
-  const size_t back = std::max<size_t>(
-      1,
-      static_cast<size_t>(std::lround(options_.dynamic.long_baseline_s / std::max(period, 1e-3))));
+  const size_t back = long_gap_;
   const LidarFrameFeatures* current;
   STCALIB_RETURN_IF_ERROR(Base(frame, &current));
   for (size_t gap : {size_t{1}, back}) {
@@ -149,6 +164,9 @@ Status SweepCache::Finished(size_t frame, const LidarFrameFeatures** features) {
     FinishLidarFrameFeatures(references, options_, &f);
     it = finished_.emplace(frame, std::move(f)).first;
     Evict(frame);
+    // A backward pass: sweeps more than a capacity after this one are not asked for again soon.
+    // (Not in Base: References holds this sweep's base while it loads one `long_gap_` back.)
+    EvictNewerThan(frame + capacity_);
   }
   *features = &it->second;
   return Status::Ok();
@@ -195,6 +213,8 @@ Status SweepCache::LocalMap(size_t frame, const LocalMapOptions& map_options, Li
                             LocalMapStats* stats) {
   STCALIB_RETURN_IF_ERROR(drive_.CheckFrame(frame));
   if (map_options.sweeps < 1) return Status::Error("local map: sweeps must be >= 1");
+  // Every sweep of the map stays cached while the map holds pointers to them.
+  capacity_ = std::max(capacity_, static_cast<size_t>(map_options.sweeps) + 1);
   *stats = LocalMapStats();
   const size_t first =
       frame + 1 >= static_cast<size_t>(map_options.sweeps) ? frame + 1 - map_options.sweeps : 0;

@@ -78,6 +78,9 @@ Status LoadLidarFrameFeatures(const Drive& drive, const DriveMotion& motion, siz
 
 // Sweeps of a drive computed once each and kept while they are among the last `capacity`
 // frames asked for: a sequential pass computes every sweep's base and finished features once.
+// The capacity grows to hold the dynamic filter's long-baseline reference and every sweep of a
+// local map; a backward pass keeps at most a capacity of sweeps after the one asked for.
+// Pointers handed out stay valid until the next call.
 class SweepCache {
  public:
   SweepCache(const Drive& drive, const DriveMotion& motion, const LidarFeatureOptions& options,
@@ -88,13 +91,18 @@ class SweepCache {
   Status References(size_t frame, std::vector<ReferenceFeatures>* references);
   Status LocalMap(size_t frame, const LocalMapOptions& map_options, LidarEdges* map,
                   LocalMapStats* stats);
+  size_t capacity() const { return capacity_; }
+  size_t cached_sweeps() const { return base_.size() + finished_.size(); }  ///< base + finished
 
  private:
+  static size_t LongBaselineGap(const Drive& drive, const DynamicFilterOptions& dynamic);
   void Evict(size_t newest);
+  void EvictNewerThan(size_t last);
   const Drive& drive_;
   const DriveMotion& motion_;
   const LidarFeatureOptions options_;
   double sweep_s_;
+  size_t long_gap_;  ///< frames back to the long-baseline reference sweep
   size_t capacity_;
   std::map<size_t, LidarFrameFeatures> base_, finished_;
 };
