@@ -72,6 +72,21 @@ LidarFrameFeatures ComputeLidarFrameFeatures(LidarScan scan, double stamp_s,
   return f;
 }
 
+namespace {
+
+// Frames back to the dynamic filter's long-baseline reference sweep.
+size_t LongBaselineGap(const Drive& drive, const DynamicFilterOptions& dynamic) {
+  const double period =
+      drive.NumFrames() > 1
+          ? NsToSeconds(drive.lidar_stamps_ns.back() - drive.lidar_stamps_ns.front()) /
+                (drive.NumFrames() - 1)
+          : 0.1;
+  return std::max<size_t>(
+      1, static_cast<size_t>(std::lround(dynamic.long_baseline_s / std::max(period, 1e-3))));
+}
+
+}  // namespace
+
 SweepCache::SweepCache(const Drive& drive, const DriveMotion& motion,
                        const LidarFeatureOptions& options, size_t capacity)
     : drive_(drive),
@@ -81,16 +96,6 @@ SweepCache::SweepCache(const Drive& drive, const DriveMotion& motion,
       long_gap_(LongBaselineGap(drive, options.dynamic)),
       // The long-baseline reference stays cached from one frame to the next.
       capacity_(std::max<size_t>({capacity, 4, long_gap_ + 2})) {}
-
-size_t SweepCache::LongBaselineGap(const Drive& drive, const DynamicFilterOptions& dynamic) {
-  const double period =
-      drive.NumFrames() > 1
-          ? NsToSeconds(drive.lidar_stamps_ns.back() - drive.lidar_stamps_ns.front()) /
-                (drive.NumFrames() - 1)
-          : 0.1;
-  return std::max<size_t>(
-      1, static_cast<size_t>(std::lround(dynamic.long_baseline_s / std::max(period, 1e-3))));
-}
 
 void SweepCache::Evict(size_t newest) {
   while (base_.size() > capacity_ && base_.begin()->first + capacity_ <= newest) {
@@ -129,11 +134,10 @@ Status SweepCache::Base(size_t frame, const LidarFrameFeatures** features) {
 Status SweepCache::References(size_t frame, std::vector<ReferenceFeatures>* references) {
   references->clear();
   if (!options_.remove_dynamic || frame == 0) return Status::Ok();
-  const size_t back = long_gap_;
   const LidarFrameFeatures* current;
   STCALIB_RETURN_IF_ERROR(Base(frame, &current));
-  for (size_t gap : {size_t{1}, back}) {
-    if (gap > frame || (gap == back && back == 1 && !references->empty())) continue;
+  for (size_t gap : {size_t{1}, long_gap_}) {
+    if (gap > frame || (gap == long_gap_ && long_gap_ == 1 && !references->empty())) continue;
     const LidarFrameFeatures* reference;
     const Status status = Base(frame - gap, &reference);
     if (!status.ok() || !(reference->stamp_s < current->stamp_s)) {

@@ -95,7 +95,6 @@ class SweepCache {
   size_t cached_sweeps() const { return base_.size() + finished_.size(); }  ///< base + finished
 
  private:
-  static size_t LongBaselineGap(const Drive& drive, const DynamicFilterOptions& dynamic);
   void Evict(size_t newest);
   void EvictNewerThan(size_t last);
   const Drive& drive_;
