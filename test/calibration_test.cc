@@ -43,7 +43,7 @@ std::shared_ptr<CalibrationFrame> BareFrame(int index, double time_s) {
 TEST(FrameSource, CameraAzimuthWindowHoldsTheFieldOfView) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
   const CameraCalibration& camera = drive.camera;
   const double fx = camera.P_rect_02(0, 0), cx = camera.P_rect_02(0, 2);
   const double half_fov_deg = std::atan(std::max(cx, camera.image_width - cx) / fx) * 180.0 / M_PI;

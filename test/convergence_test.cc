@@ -50,7 +50,7 @@ TEST(Convergence, PolishThatDoesNotConvergeRefusesTheClaim) {
 TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
   // Plain score maps (what configs/kitti.flags calibrated on until it switched to suppressed
   // ones; any drive may still be calibrated on them).
   FrameSourceOptions options;
@@ -113,7 +113,7 @@ TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
 TEST(Score, KittiBandPassPeaksAtTheCalibrationTheClippedMapDoesNot) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
   FrameSourceOptions options;
   options.suppress_texture = true;
   options.bandpass_score = true;

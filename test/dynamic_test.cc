@@ -346,9 +346,8 @@ TEST(LocalMap, EarlierSweepsArePlacedAtTheTimeOffsetToFirstOrder) {
 TEST(LocalMap, KittiMapOfThreeSweepsWithOxtsAndNdt) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
   DriveMotion motion;
-  ASSERT_TRUE(DriveMotion::Create(drive, &motion).ok());
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive, &motion));
   LidarFrameFeatures single;
   ASSERT_TRUE(LoadLidarFrameFeatures(drive, motion, 12, LidarFeatureOptions(), &single).ok());
   LidarEdges oxts_map, ndt_map;
@@ -384,9 +383,8 @@ TEST(LocalMap, KittiMapOfThreeSweepsWithOxtsAndNdt) {
 TEST(SweepCache, HoldsAWideLocalMapAndStaysBoundedOnABackwardPass) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
   DriveMotion motion;
-  ASSERT_TRUE(DriveMotion::Create(drive, &motion).ok());
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive, &motion));
   LocalMapOptions map_options;
   map_options.sweeps = 10;
   LidarEdges narrow_map, wide_map;

@@ -308,7 +308,7 @@ TEST(ImageFeatures, LsdSegmentsKeepPixelCentresAtReducedScale) {
 TEST(LidarRings, KittiFramesHaveSixtyFourRingsTopToBottom) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
   for (size_t frame : {0u, 9u, 17u, 29u}) {
     LidarScan scan;
     ASSERT_TRUE(drive.LoadScan(frame, &scan).ok());
@@ -647,9 +647,8 @@ TEST(LidarEdges, EmptyAndDegenerateInputGiveEmptyFeatures) {
 TEST(Alignment, KittiRateDropsWithTwoDegreesOfError) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
   DriveMotion motion;
-  ASSERT_TRUE(DriveMotion::Create(drive, &motion).ok());
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive, &motion));
   ImageFeatureOptions image_options;
   image_options.split_orientation = true;
   image_options.precise_distance = true;

@@ -31,7 +31,7 @@ CalibrationState RotatedBy(const CalibrationState& state, double deg, unsigned s
 TEST(HealthCheck, KittiCalibrationHoldsAndOneDegreeOffIsCaught) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
   const auto frames = LoadKittiFrames(drive, static_cast<int>(drive.NumFrames()));
   CalibrationState kitti;
   kitti.T_camera_lidar = drive.T_camera_lidar;

@@ -131,7 +131,7 @@ TEST(KittiReaders, DriveIndexesThirtyFramesWithMonotonicStamps) {
 TEST(KittiReaders, VelodynePointCountsMatchFileSizes) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
-  ASSERT_TRUE(OpenDrive(KittiDriveDir(), "", &drive).ok());
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
   for (size_t i : {size_t{0}, size_t{29}}) {
     LidarScan scan;
     ASSERT_TRUE(drive.LoadScan(i, &scan).ok());

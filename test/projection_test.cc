@@ -56,7 +56,7 @@ TEST(Projection, RectificationRotationIsApplied) {
 TEST(Projection, KittiFrameZeroLandsInsideTheImage) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
-  ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &drive).ok());
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
   cv::Mat image;
   LidarScan scan;
   ASSERT_TRUE(drive.LoadImage(0, &image).ok());

@@ -55,6 +55,13 @@ std::string MakeTinyDrive(const std::string& root, int num_frames) {
   return drive;
 }
 
+::testing::AssertionResult OpenKittiDrive(Drive* drive, DriveMotion* motion) {
+  Status status = OpenDrive(KittiDriveDir(), "", drive);
+  if (status.ok() && motion != nullptr) status = DriveMotion::Create(*drive, motion);
+  if (!status.ok()) return ::testing::AssertionFailure() << status.message();
+  return ::testing::AssertionSuccess();
+}
+
 std::vector<std::shared_ptr<const CalibrationFrame>> LoadCalibrationFrames(
     const Drive& drive, const FrameSourceOptions& options, const std::vector<int>& indices) {
   std::vector<std::shared_ptr<const CalibrationFrame>> frames;

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/io/drive.h"
+#include "core/motion/drive_motion.h"
 #include "core/online/frame_source.h"
 
 namespace stcalib::testing {
@@ -25,6 +26,10 @@ inline bool HaveKitti() { return std::filesystem::is_directory(KittiDriveDir());
     GTEST_SKIP() << "shared KITTI data not found at " << ::stcalib::testing::KittiDriveDir() \
                  << " (clone with ../shared beside the repository)";                         \
   }
+
+// Opens the shared KITTI drive and, when `motion` is given, its motion; a failure names the
+// file and the problem. Call after STCALIB_REQUIRE_KITTI(): ASSERT_TRUE(OpenKittiDrive(&drive)).
+::testing::AssertionResult OpenKittiDrive(Drive* drive, DriveMotion* motion = nullptr);
 
 // A fresh folder under the system temp dir, removed on destruction.
 class ScopedTempDir {
