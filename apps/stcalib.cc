@@ -9,6 +9,7 @@
 
 #include "apps/commands.h"
 #include "apps/flags.h"
+#include "core/types/heap.h"
 
 namespace stcalib::cli {
 namespace {
@@ -80,6 +81,8 @@ void PrintUsage(std::ostream& out) {
 }  // namespace
 
 int Main(int argc, char** argv) {
+  // Per-frame buffers are reused instead of faulted in afresh each frame (core/types/heap.h).
+  RetainFreedHeapMemory();
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
       std::strcmp(argv[1], "help") == 0) {
     PrintUsage(argc < 2 ? std::cerr : std::cout);

@@ -42,5 +42,3 @@ BENCHMARK(BM_InferCloud)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace stcalib
-
-BENCHMARK_MAIN();

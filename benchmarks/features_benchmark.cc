@@ -223,5 +223,3 @@ BENCHMARK(BM_OnlinePerFramePath)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace stcalib
-
-BENCHMARK_MAIN();

@@ -68,5 +68,3 @@ BENCHMARK(BM_ProjectFrame)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace stcalib
-
-BENCHMARK_MAIN();

@@ -260,5 +260,3 @@ BENCHMARK(BM_FrameFeatures)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace stcalib
-
-BENCHMARK_MAIN();

@@ -60,5 +60,3 @@ BENCHMARK(BM_BuildSimulator)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace stcalib::sim
-
-BENCHMARK_MAIN();

@@ -1,8 +1,14 @@
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <random>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include "core/types/calibration.h"
+#include "core/types/heap.h"
 
 namespace stcalib {
 namespace {
@@ -70,6 +76,27 @@ TEST(CalibrationError, RotationErrorOfKnownAngle) {
   const Eigen::Matrix3d b = Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   EXPECT_NEAR(RotationErrorDeg(a, b), 0.5 * 180 / M_PI, 1e-9);
   EXPECT_NEAR(RotationErrorDeg(a, a), 0.0, 1e-6);
+}
+
+// A 48 MiB block (larger than glibc's default mmap threshold and than its dynamic threshold's
+// 32 MiB ceiling) comes from the heap once RetainFreedHeapMemory() has run, and freeing it
+// leaves its pages with the process instead of unmapping or trimming them.
+TEST(Heap, RetainedLargeBlocksComeFromTheHeapAndStayAfterFree) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer replaces the allocator (its mallopt does nothing)";
+#elif defined(__GLIBC__)
+  ASSERT_TRUE(RetainFreedHeapMemory());
+  constexpr size_t kBytes = size_t{48} << 20;
+  const size_t mapped_before = mallinfo2().hblkhd;
+  char* volatile block = static_cast<char*>(std::malloc(kBytes));
+  ASSERT_NE(block, nullptr);
+  block[kBytes - 1] = 1;
+  EXPECT_EQ(mallinfo2().hblkhd, mapped_before) << "the block was mmapped";
+  std::free(block);
+  EXPECT_GE(mallinfo2().fordblks, kBytes) << "the freed block was returned to the kernel";
+#else
+  GTEST_SKIP() << "not glibc: RetainFreedHeapMemory() changes nothing";
+#endif
 }
 
 }  // namespace
