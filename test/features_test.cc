@@ -7,10 +7,13 @@
 #include <cstdio>
 #include <functional>
 #include <opencv2/imgproc.hpp>
+#include <random>
+#include <utility>
 
 #include "core/features/ground.h"
 #include "core/features/image_features.h"
 #include "core/features/lidar_frame.h"
+#include "core/features/lidar_rings.h"
 #include "core/features/projection_filter.h"
 #include "core/io/drive.h"
 #include "core/motion/drive_motion.h"
@@ -303,6 +306,24 @@ TEST(ImageFeatures, LsdSegmentsKeepPixelCentresAtReducedScale) {
     ASSERT_EQ(found, 4) << "scale " << scale;
     EXPECT_LT(std::abs(sum / found), 0.3) << "scale " << scale;
   }
+}
+
+// The ring splitter's and the edge detector's wrapped azimuth step is std::remainder's, bit for
+// bit, over every pair of azimuths ScanRings can hold (a wrap included).
+TEST(LidarRings, WrappedAzimuthStepIsTheRemainderBitForBit) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> azimuth(static_cast<float>(-M_PI),
+                                                static_cast<float>(M_PI));
+  std::vector<std::pair<float, float>> pairs = {
+      {-3.14159f, 3.14159f}, {3.14159f, -3.14159f}, {0.0f, 0.0f}, {-1e-7f, 1e-7f}};
+  for (int i = 0; i < 200000; ++i) pairs.emplace_back(azimuth(rng), azimuth(rng));
+  int wrapped = 0;
+  for (const auto& [from, to] : pairs) {
+    const double expected = std::remainder(to - from, 2 * M_PI);
+    ASSERT_EQ(WrappedAzimuthStep(from, to), expected) << from << " -> " << to;
+    if (std::abs(to - from) > M_PI) ++wrapped;
+  }
+  EXPECT_GT(wrapped, 40000);  // a quarter of random pairs wrap
 }
 
 TEST(LidarRings, KittiFramesHaveSixtyFourRingsTopToBottom) {

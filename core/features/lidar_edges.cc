@@ -168,7 +168,7 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
         const int next = j + dir;
         if (next < begin || next >= end) return kNoReturn;
         const double gap =
-            std::abs(std::remainder(rings.azimuth_rad[next] - rings.azimuth_rad[j], 2 * M_PI));
+            std::abs(WrappedAzimuthStep(rings.azimuth_rad[j], rings.azimuth_rad[next]));
         if (gap > options.max_gap_steps * step) return kNoReturn;
         j = next;
       }

@@ -40,7 +40,7 @@ ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points) {
         ++count;
       }
       if (i > rings.ring_begin[r] && (i % 7) == 0) {
-        const double d = std::remainder(rings.azimuth_rad[i] - rings.azimuth_rad[i - 1], 2 * M_PI);
+        const double d = WrappedAzimuthStep(rings.azimuth_rad[i - 1], rings.azimuth_rad[i]);
         if (d > 0 && d < 0.02) steps.push_back(d);
       }
     }
