@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/features/fast_atan2.h"
 #include "core/features/kdtree.h"
 
 namespace stcalib {
@@ -133,8 +134,8 @@ class RangeImage {
   static constexpr int kAz = 1440, kEl = 160;  // 0.25° cells, elevation −30°..+10°
   static constexpr float kEmpty = std::numeric_limits<float>::infinity();
   static int Cell(const Eigen::Vector3d& p) {
-    const double az = std::atan2(p.y(), p.x());
-    const double el = std::atan2(p.z(), p.head<2>().norm());
+    const double az = FastAtan2(p.y(), p.x());
+    const double el = FastAtan2(p.z(), p.head<2>().norm());
     const int a = static_cast<int>((az + M_PI) / (2 * M_PI) * kAz);
     const int e = static_cast<int>((el * 180 / M_PI + 30.0) / 0.25);
     if (e < 0 || e >= kEl) return -1;
