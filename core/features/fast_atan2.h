@@ -5,7 +5,8 @@
 
 namespace stcalib {
 
-// atan2(y, x) in [−π, π] to within 2e-11 rad (tested against std::atan2), branch-light and
+// atan2(y, x) in [−π, π] to within 2e-11 rad (tested against std::atan2) for finite y and x (NaN
+// and infinities give meaningless angles: callers pass finite points), branch-light and
 // inlined: several times cheaper than libm's correctly rounded atan2, for the dynamic filter's
 // range image, which bins two angles per point into 0.25° cells (a cell changes only for a point
 // within 2e-11 rad of a border).
@@ -16,7 +17,7 @@ namespace stcalib {
 inline double FastAtan2(double y, double x) {
   const double ax = std::abs(x), ay = std::abs(y);
   const double hi = std::max(ax, ay), lo = std::min(ax, ay);
-  if (hi == 0) return x < 0 || std::signbit(x) ? std::copysign(M_PI, y) : y;  // as std::atan2
+  if (hi == 0) return std::signbit(x) ? std::copysign(M_PI, y) : y;  // ±0, ±0 as std::atan2
   double t = lo / hi;
   constexpr double kTanPiOver8 = 0.41421356237309504880;
   double base = 0;
