@@ -16,6 +16,7 @@ int RunSimulate() {
   options.time_offset_s = FLAGS_time_offset_s;
   options.dynamic_objects = FLAGS_dynamic_objects;
   options.lidar_hz = FLAGS_lidar_hz;
+  options.oxts_error.position_white_m = FLAGS_oxts_white_position_m;
   if (!sim::ParseSceneType(FLAGS_scene, &options.scene)) {
     return UsageError("simulate",
                       "--scene must be " + sim::SceneTypeChoices() + ", got '" + FLAGS_scene + "'");

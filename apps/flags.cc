@@ -22,6 +22,9 @@ DEFINE_string(camera, "kitti",
               "simulate: kitti (1242x375) | kitti_1003 (1241x376) | hd720 (1280x720, 3 deg "
               "nose-down)");
 DEFINE_double(lidar_hz, 10.0, "simulate: LiDAR spin rate = frame rate of every sensor [Hz]");
+DEFINE_double(oxts_white_position_m, 0.001,
+              "simulate: σ of each oxts packet's own position noise per axis, on top of the "
+              "smooth drift of a GPS/INS solution [m]; 0.01 stresses the local map");
 DEFINE_string(detector, "canny", "image edges: canny | lsd | fld (cv::ximgproc FastLineDetector)");
 DEFINE_double(min_segment_px, 15, "lsd/fld: shorter segments are dropped as texture [px]");
 DEFINE_double(max_edge_density, 0.0,

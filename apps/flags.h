@@ -15,6 +15,7 @@ DECLARE_int32(dynamic_objects);
 DECLARE_string(scene);
 DECLARE_string(camera);
 DECLARE_double(lidar_hz);
+DECLARE_double(oxts_white_position_m);
 DECLARE_string(detector);
 DECLARE_double(min_segment_px);
 DECLARE_double(max_edge_density);

@@ -15,6 +15,7 @@
 #include "core/io/drive.h"
 #include "core/io/image.h"
 #include "core/motion/oxts_poses.h"
+#include "core/motion/oxts_trajectory.h"
 #include "core/score/projection.h"
 #include "core/sim/simulator.h"
 #include "core/types/calibration.h"
@@ -178,12 +179,22 @@ TEST(Simulator, OxtsIntegratesToTheTruePoses) {
     const std::vector<Eigen::Vector3d> integrated =
         IntegrateOxtsVelocities(packets, stamps_s, truth[0].translation());
     double yaw_from_rates = packets[0].yaw, speed_from_accel = packets[0].vf;
+    Eigen::Vector3d previous_error = Eigen::Vector3d::Zero();
     for (size_t i = 0; i < truth.size(); ++i) {
-      EXPECT_LT((integrated[i] - truth[i].translation()).norm(), 0.005 * path_length)
+      // The velocities drift on their own, as KITTI's do: integrated over the shared 30 frames
+      // (34 m) they end 0.46 m (1.35 %) from KITTI's positions.
+      EXPECT_LT((integrated[i] - truth[i].translation()).norm(), 0.02 * path_length)
           << "seed " << seed << " frame " << i;
-      // GPS/INS poses (Mercator, attitude) agree with the truth.
+      // GPS/INS poses (Mercator, attitude) agree with the truth, and their error is smooth: it
+      // changes by millimetres from one packet to the next (white noise of 1 cm per packet,
+      // which no GPS/INS solution has, would change it by 1.4 cm).
       const Rigid3d pose = OxtsPose(sim.oxts_origin(), packets[i]);
-      EXPECT_LT((pose.translation() - truth[i].translation()).norm(), 0.06);
+      const Eigen::Vector3d error = pose.translation() - truth[i].translation();
+      EXPECT_LT(error.norm(), 0.1);
+      if (i > 0) {
+        EXPECT_LT((error - previous_error).norm(), 0.008) << "frame " << i;
+      }
+      previous_error = error;
       EXPECT_LT(RotationErrorDeg(pose.linear(), truth[i].linear()), 0.05);
       if (i > 0) {
         // Heading rate wu integrates to the heading; forward acceleration to the speed change.
@@ -191,11 +202,71 @@ TEST(Simulator, OxtsIntegratesToTheTruePoses) {
         yaw_from_rates += 0.5 * dt * (packets[i - 1].wu + packets[i].wu);
         EXPECT_NEAR(std::remainder(yaw_from_rates - packets[i].yaw, 2 * M_PI), 0.0, 2e-3);
         speed_from_accel += 0.5 * dt * (packets[i - 1].af + packets[i].af);
-        EXPECT_NEAR(speed_from_accel, packets[i].vf, 0.15);
+        // 0.15 m/s of accelerometer noise plus the velocities' own drift (σ 0.08 m/s).
+        EXPECT_NEAR(speed_from_accel, packets[i].vf, 0.4);
       }
       EXPECT_NEAR(packets[i].az, 9.80665, 0.5);  // specific force includes gravity
     }
   }
+}
+
+// What the local map rests on: the motion between sweeps 0.2 s apart, read back from the written
+// packets by OxtsTrajectory, is within millimetres and a few 0.01° of the truth (white position
+// noise of 1 cm per packet would make it 1.4-2.5 cm).
+TEST(Simulator, OxtsRelativeMotionMatchesTheTruth) {
+  for (uint64_t seed : {1u, 13u, 29u}) {
+    const Simulator sim(SmallOptions(seed, 20));
+    std::vector<OxtsPacket> packets;
+    std::vector<StampNs> stamps;
+    for (int i = 0; i < 20; ++i) {
+      packets.push_back(sim.SimulateOxts(i));
+      stamps.push_back(sim.Timing(i).oxts_stamp_ns);
+    }
+    OxtsTrajectory trajectory;
+    ASSERT_TRUE(OxtsTrajectory::Create(packets, stamps, &trajectory).ok());
+    auto stamp = [&](double t_s) { return sim.start_stamp_ns() + SecondsToNs(t_s); };
+    for (int i = 2; i < 20; ++i) {
+      const double t0 = sim.LidarMidTime(i - 2);
+      for (double t : {sim.LidarMidTime(i) - 0.04, sim.LidarMidTime(i) + 0.04}) {
+        const Rigid3d estimate =
+            trajectory.T_world_imu(stamp(t0)).inverse() * trajectory.T_world_imu(stamp(t));
+        const Rigid3d truth =
+            sim.trajectory().T_world_imu(t0).inverse() * sim.trajectory().T_world_imu(t);
+        EXPECT_LT(RotationErrorDeg(estimate.linear(), truth.linear()), 0.06)
+            << "seed " << seed << " frame " << i;
+        EXPECT_LT((estimate.translation() - truth.translation()).norm(), 0.012)
+            << "seed " << seed << " frame " << i;
+      }
+    }
+  }
+}
+
+TEST(NavigationError, DriftRateIsTheDerivativeAndSigmaIsAsSet) {
+  NavigationErrorOptions options;
+  std::mt19937_64 rng(7);
+  const NavigationError error(options, &rng);
+  constexpr double h = 1e-4;
+  double sum_sq = 0, angle_sum_sq = 0, velocity_sum_sq = 0;
+  int n = 0;
+  for (double t = 0; t < 20000.0; t += 0.7, ++n) {
+    const Eigen::Vector3d numeric =
+        (error.PositionDrift(t + h) - error.PositionDrift(t - h)) / (2 * h);
+    if (n < 1000) {
+      EXPECT_LT((numeric - error.PositionDriftRate(t)).norm(), 1e-7) << t;
+    }
+    sum_sq += error.PositionDrift(t).squaredNorm();
+    angle_sum_sq += error.AngleDrift(t).squaredNorm();
+    velocity_sum_sq += error.VelocityDrift(t).head<2>().squaredNorm();
+  }
+  // Over many periods the sample σ per axis approaches the set one.
+  EXPECT_NEAR(std::sqrt(sum_sq / (3 * n)), options.position_drift_m,
+              0.15 * options.position_drift_m);
+  EXPECT_NEAR(std::sqrt(angle_sum_sq / (3 * n)), options.angle_drift_rad,
+              0.15 * options.angle_drift_rad);
+  EXPECT_NEAR(std::sqrt(velocity_sum_sq / (2 * n)), options.velocity_drift_mps,
+              0.15 * options.velocity_drift_mps);
+  // No drift without options: the default error is zero.
+  EXPECT_EQ(NavigationError().PositionDrift(3.0), Eigen::Vector3d::Zero());
 }
 
 TEST(Simulator, DriveRoundTripsThroughTheKittiReader) {

@@ -194,8 +194,65 @@ cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, c
   return image;
 }
 
+NavigationError::NavigationError(const NavigationErrorOptions& options, std::mt19937_64* rng)
+    : options_(options) {
+  // Periods log-uniform in [min, max]; equal amplitudes so that each axis has the set σ
+  // (a sinusoid of amplitude a has variance a²/2).
+  std::uniform_real_distribution<double> phase(0, 2 * M_PI);
+  auto draw = [&](const Eigen::Vector3d& sigma, double min_period_s, double max_period_s,
+                  std::array<Axis, 3>* axes) {
+    std::uniform_real_distribution<double> log_period(std::log(min_period_s),
+                                                      std::log(max_period_s));
+    for (int i = 0; i < 3; ++i) {
+      for (Term& term : (*axes)[i]) {
+        term.amplitude = sigma[i] * std::sqrt(2.0 / kTerms);
+        term.angular_frequency = 2 * M_PI / std::exp(log_period(*rng));
+        term.phase = phase(*rng);
+      }
+    }
+  };
+  const NavigationErrorOptions& o = options;
+  draw(Eigen::Vector3d::Constant(o.position_drift_m), o.min_period_s, o.max_period_s, &position_);
+  draw(Eigen::Vector3d::Constant(o.angle_drift_rad), o.min_period_s, o.max_period_s, &angle_);
+  draw(Eigen::Vector3d(o.velocity_drift_mps, o.velocity_drift_mps, o.vertical_velocity_drift_mps),
+       o.velocity_min_period_s, o.velocity_max_period_s, &velocity_);
+}
+
+double NavigationError::Value(const Axis& axis, double t_s) {
+  double sum = 0;
+  for (const Term& term : axis) {
+    sum += term.amplitude * std::sin(term.angular_frequency * t_s + term.phase);
+  }
+  return sum;
+}
+
+double NavigationError::Rate(const Axis& axis, double t_s) {
+  double sum = 0;
+  for (const Term& term : axis) {
+    sum += term.amplitude * term.angular_frequency *
+           std::cos(term.angular_frequency * t_s + term.phase);
+  }
+  return sum;
+}
+
+Eigen::Vector3d NavigationError::PositionDrift(double t_s) const {
+  return {Value(position_[0], t_s), Value(position_[1], t_s), Value(position_[2], t_s)};
+}
+
+Eigen::Vector3d NavigationError::PositionDriftRate(double t_s) const {
+  return {Rate(position_[0], t_s), Rate(position_[1], t_s), Rate(position_[2], t_s)};
+}
+
+Eigen::Vector3d NavigationError::AngleDrift(double t_s) const {
+  return {Value(angle_[0], t_s), Value(angle_[1], t_s), Value(angle_[2], t_s)};
+}
+
+Eigen::Vector3d NavigationError::VelocityDrift(double t_s) const {
+  return {Value(velocity_[0], t_s), Value(velocity_[1], t_s), Value(velocity_[2], t_s)};
+}
+
 OxtsPacket SynthesizeOxtsPacket(const SimTrajectory& trajectory, const OxtsOrigin& origin,
-                                double t_s, std::mt19937_64* rng) {
+                                const NavigationError& error, double t_s, std::mt19937_64* rng) {
   constexpr double h = 1e-3;  // central differences [s]
   const Rigid3d T0 = trajectory.T_world_imu(t_s - h);
   const Rigid3d T1 = trajectory.T_world_imu(t_s);
@@ -209,28 +266,40 @@ OxtsPacket SynthesizeOxtsPacket(const SimTrajectory& trajectory, const OxtsOrigi
       Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d specific_force = a_world + Eigen::Vector3d(0, 0, kGravity);
 
-  std::normal_distribution<double> n_angle(0, 2e-4), n_vel(0, 0.02), n_acc(0, 0.05),
-      n_rate(0, 5e-4), n_pos(0, 0.01);
+  const NavigationErrorOptions& noise = error.options();
+  std::normal_distribution<double> n_angle(0, noise.angle_white_rad),
+      n_vel(0, noise.velocity_white_mps), n_pos(0, noise.position_white_m), n_acc(0, 0.05),
+      n_rate(0, 5e-4);
+  auto white = [&](std::normal_distribution<double>& n) {  // draws in x, y, z order
+    Eigen::Vector3d v;
+    for (int i = 0; i < 3; ++i) v[i] = n(*rng);
+    return v;
+  };
   OxtsPacket p;
   // Invert the Mercator projection of oxts_poses.h (scale of the origin latitude).
   const double scale = std::cos(origin.lat_deg * M_PI / 180.0);
   const double x0 = scale * kEarthRadiusM * origin.lon_deg * M_PI / 180.0;
   const double y0 =
       scale * kEarthRadiusM * std::log(std::tan(M_PI * (90.0 + origin.lat_deg) / 360.0));
-  const double x = T1.translation().x() + n_pos(*rng) + x0;
-  const double y = T1.translation().y() + n_pos(*rng) + y0;
-  p.lon = x / (scale * kEarthRadiusM) * 180.0 / M_PI;
-  p.lat = 360.0 / M_PI * std::atan(std::exp(y / (scale * kEarthRadiusM))) - 90.0;
-  p.alt = origin.alt_m + T1.translation().z() + n_pos(*rng);
-  p.roll = rpy.x() + n_angle(*rng);
-  p.pitch = rpy.y() + n_angle(*rng);
-  p.yaw = std::remainder(rpy.z() + n_angle(*rng), 2 * M_PI);
-  p.vn = v_world.y() + n_vel(*rng);
-  p.ve = v_world.x() + n_vel(*rng);
-  const Eigen::Vector3d v_heading = R_heading.transpose() * v_world;
-  p.vf = v_heading.x() + n_vel(*rng);
-  p.vl = v_heading.y() + n_vel(*rng);
-  p.vu = v_heading.z() + n_vel(*rng);
+  const Eigen::Vector3d position = T1.translation() + error.PositionDrift(t_s) + white(n_pos);
+  p.lon = (position.x() + x0) / (scale * kEarthRadiusM) * 180.0 / M_PI;
+  p.lat = 360.0 / M_PI * std::atan(std::exp((position.y() + y0) / (scale * kEarthRadiusM))) - 90.0;
+  p.alt = origin.alt_m + position.z();
+  const Eigen::Vector3d attitude = rpy + error.AngleDrift(t_s) + white(n_angle);
+  p.roll = attitude.x();
+  p.pitch = attitude.y();
+  p.yaw = std::remainder(attitude.z(), 2 * M_PI);
+  // The velocity carries the position drift's rate and a drift of its own; the heading frame is
+  // the written yaw's.
+  const Eigen::Vector3d velocity =
+      v_world + error.PositionDriftRate(t_s) + error.VelocityDrift(t_s) + white(n_vel);
+  p.vn = velocity.y();
+  p.ve = velocity.x();
+  const Eigen::Vector3d v_heading =
+      Eigen::AngleAxisd(attitude.z(), Eigen::Vector3d::UnitZ()).inverse() * velocity;
+  p.vf = v_heading.x();
+  p.vl = v_heading.y();
+  p.vu = v_heading.z();
   const Eigen::Vector3d a_body = T1.linear().transpose() * specific_force;
   p.ax = a_body.x() + n_acc(*rng);
   p.ay = a_body.y() + n_acc(*rng);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <random>
@@ -58,8 +59,55 @@ struct CameraRig {
 cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, const CameraRig& rig,
                           double t_s, std::mt19937_64* rng);
 
-// An oxts packet of the true motion at t_s with measurement noise.
+// The error of a fused GPS/INS navigation solution such as KITTI's OXTS RT3003 (RTK): a smooth
+// drift of a few centimetres and a few 1e-4 rad that wanders over tens of seconds, plus a small
+// white part per packet. The drift is a sum of sinusoids with random periods and phases, so it
+// can be evaluated at any time alone (each frame is simulated alone) and its rate is exact: the
+// written velocities carry the position drift's rate, as a Kalman filter's output would, and a
+// slow drift of their own. That is what KITTI's shared packets show: the difference between a
+// position step and the velocities' step over it has a high-frequency part of 1.3-4.2 mm per axis
+// and is otherwise slow (lag-1 autocorrelation +0.68..+0.89, σ 3-14 mm per 0.1 s), and the
+// velocities integrated over the 30 frames (34 m) end 0.46 m from the positions.
+struct NavigationErrorOptions {
+  double position_drift_m = 0.02;    ///< σ of the slow position error, per axis [m]
+  double angle_drift_rad = 2e-4;     ///< σ of the slow roll, pitch and yaw error [rad]
+  double velocity_drift_mps = 0.08;  ///< σ of the velocities' own slow error, east and north [m/s]
+  double vertical_velocity_drift_mps = 0.025;  ///< the same, up [m/s]
+  double min_period_s = 10.0;           ///< shortest period of the position and attitude drift [s]
+  double max_period_s = 100.0;          ///< longest period of the position and attitude drift [s]
+  double velocity_min_period_s = 2.0;   ///< shortest period of the velocities' drift [s]
+  double velocity_max_period_s = 20.0;  ///< longest period of the velocities' drift [s]
+  double position_white_m = 0.001;      ///< σ of each packet's own position noise, per axis [m]
+  double angle_white_rad = 2e-5;        ///< σ of each packet's own attitude noise [rad]
+  double velocity_white_mps = 0.02;     ///< σ of each packet's own velocity noise, per axis [m/s]
+};
+
+class NavigationError {
+ public:
+  NavigationError() = default;  ///< no drift
+  NavigationError(const NavigationErrorOptions& options, std::mt19937_64* rng);
+
+  const NavigationErrorOptions& options() const { return options_; }
+  Eigen::Vector3d PositionDrift(double t_s) const;      ///< east, north, up [m]
+  Eigen::Vector3d PositionDriftRate(double t_s) const;  ///< d/dt of PositionDrift [m/s]
+  Eigen::Vector3d AngleDrift(double t_s) const;         ///< roll, pitch, yaw [rad]
+  Eigen::Vector3d VelocityDrift(double t_s) const;      ///< east, north, up, beyond the rate [m/s]
+
+ private:
+  static constexpr int kTerms = 4;  ///< sinusoids per axis
+  struct Term {
+    double amplitude = 0, angular_frequency = 0, phase = 0;
+  };
+  using Axis = std::array<Term, kTerms>;
+  static double Value(const Axis& axis, double t_s);
+  static double Rate(const Axis& axis, double t_s);
+
+  NavigationErrorOptions options_;
+  std::array<Axis, 3> position_{}, angle_{}, velocity_{};
+};
+
+// An oxts packet of the true motion at t_s with `error`'s drift and white noise drawn from `rng`.
 OxtsPacket SynthesizeOxtsPacket(const SimTrajectory& trajectory, const OxtsOrigin& origin,
-                                double t_s, std::mt19937_64* rng);
+                                const NavigationError& error, double t_s, std::mt19937_64* rng);
 
 }  // namespace stcalib::sim

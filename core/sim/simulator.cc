@@ -26,7 +26,8 @@ enum Stream : uint64_t {
   kFrameLidar,
   kFrameCamera,
   kFrameOxts,
-  kFrameClock
+  kFrameClock,
+  kOxtsDrift
 };
 
 std::mt19937_64 MakeRng(uint64_t seed, uint64_t stream, uint64_t frame = 0) {
@@ -159,6 +160,18 @@ Status SimulatorOptions::Validate() const {
   if (!(std::abs(camera_delay_s) < 0.5 / lidar_hz)) {
     return Status::Error("camera delay must be under half a frame period");
   }
+  const NavigationErrorOptions& e = oxts_error;
+  for (double sigma :
+       {e.position_drift_m, e.angle_drift_rad, e.velocity_drift_mps, e.vertical_velocity_drift_mps,
+        e.position_white_m, e.angle_white_rad, e.velocity_white_mps}) {
+    if (!(sigma >= 0.0 && sigma <= 10.0)) {
+      return Status::Error("oxts noise σ must be between 0 and 10, got " + std::to_string(sigma));
+    }
+  }
+  if (!(e.min_period_s > 0.0 && e.max_period_s >= e.min_period_s && e.velocity_min_period_s > 0.0 &&
+        e.velocity_max_period_s >= e.velocity_min_period_s)) {
+    return Status::Error("oxts drift periods must be positive and ordered");
+  }
   return Status::Ok();
 }
 
@@ -199,6 +212,8 @@ Simulator::Simulator(const SimulatorOptions& options) : options_(options) {
       Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
   std::uniform_real_distribution<double> lat(48.9, 49.1), lon(8.3, 8.5), alt(100, 130);
   origin_ = {lat(calib_rng), lon(calib_rng), alt(calib_rng)};
+  std::mt19937_64 drift_rng = MakeRng(seed, kOxtsDrift);
+  oxts_error_ = NavigationError(options.oxts_error, &drift_rng);
   // 2026-01-01 12:00:00 UTC plus one day per seed (mod a year).
   start_stamp_ns_ = (1767268800LL + static_cast<int64_t>(seed % 365) * 86400LL) * 1000000000LL;
 }
@@ -245,7 +260,8 @@ FrameTiming Simulator::Timing(int frame) const {
 
 OxtsPacket Simulator::SimulateOxts(int frame) const {
   std::mt19937_64 oxts_rng = MakeRng(options_.seed, kFrameOxts, frame);
-  return SynthesizeOxtsPacket(*trajectory_, origin_, Timing(frame).oxts_time_s, &oxts_rng);
+  return SynthesizeOxtsPacket(*trajectory_, origin_, oxts_error_, Timing(frame).oxts_time_s,
+                              &oxts_rng);
 }
 
 SimulatedSweep Simulator::SimulateSweep(int frame) const {

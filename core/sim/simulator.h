@@ -40,6 +40,7 @@ struct SimulatorOptions {
   double lidar_hz = 10.0;          ///< spin rate = frame rate of every sensor [Hz]
   double camera_delay_s = 0.0105;  ///< camera exposure after the LiDAR faces forward [s]
   SimCamera camera = SimCamera::kKitti;
+  NavigationErrorOptions oxts_error;  ///< the oxts packets' drift and noise
 
   Status Validate() const;
 };
@@ -95,6 +96,7 @@ class Simulator {
   CameraRig rig_;
   LidarModel lidar_;
   OxtsOrigin origin_;
+  NavigationError oxts_error_;
   StampNs start_stamp_ns_ = 0;
 };
 
