@@ -521,7 +521,8 @@ TEST(Cli, SimulateRejectsBadFlags) {
        {std::string("--frames=0"), std::string("--frames=-5"), std::string("--lidar_hz=500"),
         std::string("--lidar_hz=0"), std::string("--time_offset_s=3"),
         std::string("--dynamic_objects=-1"), std::string("--scene=forest"),
-        std::string("--camera=fisheye")}) {
+        std::string("--camera=fisheye"), std::string("--oxts_white_position_m=-0.01"),
+        std::string("--oxts_white_position_m=nan")}) {
     const RunResult r = RunStcalib("simulate" + out + " " + flags);
     EXPECT_EQ(r.exit_code, 2) << flags << ": " << r.output;
     EXPECT_THAT(r.output, HasSubstr("usage error")) << flags;
@@ -529,6 +530,8 @@ TEST(Cli, SimulateRejectsBadFlags) {
   // Unknown names are answered with the names the simulator knows.
   EXPECT_THAT(RunStcalib("simulate" + out + " --scene=forest").output,
               HasSubstr("--scene must be urban, poles or open, got 'forest'"));
+  EXPECT_THAT(RunStcalib("simulate" + out + " --oxts_white_position_m=nan").output,
+              HasSubstr("--oxts_white_position_m must be between 0 and 1 m, got nan"));
   EXPECT_THAT(RunStcalib("simulate" + out + " --camera=fisheye").output,
               HasSubstr("--camera must be kitti, kitti_1003 or hd720, got 'fisheye'"));
   EXPECT_FALSE(std::filesystem::exists(tmp.path() + "/o"));

@@ -161,9 +161,12 @@ Status SimulatorOptions::Validate() const {
     return Status::Error("camera delay must be under half a frame period");
   }
   const NavigationErrorOptions& e = oxts_error;
-  for (double sigma :
-       {e.position_drift_m, e.angle_drift_rad, e.velocity_drift_mps, e.vertical_velocity_drift_mps,
-        e.position_white_m, e.angle_white_rad, e.velocity_white_mps}) {
+  if (!(e.position_white_m >= 0.0 && e.position_white_m <= 1.0)) {
+    return Status::Error("--oxts_white_position_m must be between 0 and 1 m, got " +
+                         std::to_string(e.position_white_m));
+  }
+  for (double sigma : {e.position_drift_m, e.angle_drift_rad, e.velocity_drift_mps,
+                       e.vertical_velocity_drift_mps, e.angle_white_rad, e.velocity_white_mps}) {
     if (!(sigma >= 0.0 && sigma <= 10.0)) {
       return Status::Error("oxts noise σ must be between 0 and 10, got " + std::to_string(sigma));
     }
