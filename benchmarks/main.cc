@@ -6,6 +6,7 @@
 #include "core/types/heap.h"
 
 int main(int argc, char** argv) {
+  google::InitGoogleLogging(argv[0]);
   if (!stcalib::RetainFreedHeapMemory()) LOG(WARNING) << "freed heap memory is not retained";
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
