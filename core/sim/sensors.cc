@@ -218,37 +218,32 @@ NavigationError::NavigationError(const NavigationErrorOptions& options, std::mt1
        o.velocity_min_period_s, o.velocity_max_period_s, &velocity_);
 }
 
-double NavigationError::Value(const Axis& axis, double t_s) {
-  double sum = 0;
-  for (const Term& term : axis) {
-    sum += term.amplitude * std::sin(term.angular_frequency * t_s + term.phase);
+Eigen::Vector3d NavigationError::Evaluate(const std::array<Axis, 3>& axes, double t_s, bool rate) {
+  Eigen::Vector3d out = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 3; ++i) {
+    for (const Term& term : axes[i]) {
+      const double angle = term.angular_frequency * t_s + term.phase;
+      out[i] += rate ? term.amplitude * term.angular_frequency * std::cos(angle)
+                     : term.amplitude * std::sin(angle);
+    }
   }
-  return sum;
-}
-
-double NavigationError::Rate(const Axis& axis, double t_s) {
-  double sum = 0;
-  for (const Term& term : axis) {
-    sum += term.amplitude * term.angular_frequency *
-           std::cos(term.angular_frequency * t_s + term.phase);
-  }
-  return sum;
+  return out;
 }
 
 Eigen::Vector3d NavigationError::PositionDrift(double t_s) const {
-  return {Value(position_[0], t_s), Value(position_[1], t_s), Value(position_[2], t_s)};
+  return Evaluate(position_, t_s, /*rate=*/false);
 }
 
 Eigen::Vector3d NavigationError::PositionDriftRate(double t_s) const {
-  return {Rate(position_[0], t_s), Rate(position_[1], t_s), Rate(position_[2], t_s)};
+  return Evaluate(position_, t_s, /*rate=*/true);
 }
 
 Eigen::Vector3d NavigationError::AngleDrift(double t_s) const {
-  return {Value(angle_[0], t_s), Value(angle_[1], t_s), Value(angle_[2], t_s)};
+  return Evaluate(angle_, t_s, /*rate=*/false);
 }
 
 Eigen::Vector3d NavigationError::VelocityDrift(double t_s) const {
-  return {Value(velocity_[0], t_s), Value(velocity_[1], t_s), Value(velocity_[2], t_s)};
+  return Evaluate(velocity_, t_s, /*rate=*/false);
 }
 
 OxtsPacket SynthesizeOxtsPacket(const SimTrajectory& trajectory, const OxtsOrigin& origin,

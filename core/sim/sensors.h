@@ -84,7 +84,7 @@ struct NavigationErrorOptions {
 
 class NavigationError {
  public:
-  NavigationError() = default;  ///< no drift
+  NavigationError() = default;  ///< no drift; the default options' white noise
   NavigationError(const NavigationErrorOptions& options, std::mt19937_64* rng);
 
   const NavigationErrorOptions& options() const { return options_; }
@@ -99,8 +99,8 @@ class NavigationError {
     double amplitude = 0, angular_frequency = 0, phase = 0;
   };
   using Axis = std::array<Term, kTerms>;
-  static double Value(const Axis& axis, double t_s);
-  static double Rate(const Axis& axis, double t_s);
+  // Each axis's sum of sinusoids at t_s, or (rate) its time derivative.
+  static Eigen::Vector3d Evaluate(const std::array<Axis, 3>& axes, double t_s, bool rate);
 
   NavigationErrorOptions options_;
   std::array<Axis, 3> position_{}, angle_{}, velocity_{};
