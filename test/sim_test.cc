@@ -241,6 +241,75 @@ TEST(Simulator, OxtsRelativeMotionMatchesTheTruth) {
   }
 }
 
+// The oxts error as the local map and the motion model feel it: how far the velocities,
+// integrated over the drive, end from the positions (a share of the path length), and the
+// high-frequency part of the gap between a position step and the velocities' step over it (RMS
+// of its successive differences / √2, the largest axis) [m].
+struct OxtsErrorStats {
+  double integrated_share = 0;
+  double high_frequency_m = 0;
+};
+
+OxtsErrorStats MeasureOxtsError(const std::vector<OxtsPacket>& packets,
+                                const std::vector<double>& stamps_s) {
+  const OxtsOrigin origin{packets[0].lat, packets[0].lon, packets[0].alt};
+  std::vector<Eigen::Vector3d> positions;
+  for (const OxtsPacket& p : packets) positions.push_back(OxtsPose(origin, p).translation());
+  const std::vector<Eigen::Vector3d> integrated =
+      IntegrateOxtsVelocities(packets, stamps_s, positions[0]);
+  OxtsErrorStats stats;
+  double path_m = 0;
+  std::vector<Eigen::Vector3d> gap;
+  for (size_t i = 1; i < positions.size(); ++i) {
+    path_m += (positions[i] - positions[i - 1]).norm();
+    stats.integrated_share =
+        std::max(stats.integrated_share, (integrated[i] - positions[i]).norm());
+    gap.push_back(positions[i] - positions[i - 1] - (integrated[i] - integrated[i - 1]));
+  }
+  stats.integrated_share /= path_m;
+  Eigen::Vector3d sum_sq = Eigen::Vector3d::Zero();
+  for (size_t i = 1; i < gap.size(); ++i) sum_sq += (gap[i] - gap[i - 1]).cwiseAbs2();
+  stats.high_frequency_m = std::sqrt(sum_sq.maxCoeff() / (gap.size() - 1) / 2);
+  return stats;
+}
+
+// KITTI's shared packets against simulated ones: both have a slow velocity drift and millimetres
+// of high-frequency error; white noise of 1 cm per packet (the simulator before 2026-12-03) has
+// about 13 mm.
+TEST(Simulator, OxtsErrorLooksLikeKittis) {
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
+  std::vector<double> kitti_stamps_s;
+  for (StampNs stamp : drive.oxts_stamps_ns) {
+    kitti_stamps_s.push_back(NsToSeconds(stamp - drive.oxts_stamps_ns.front()));
+  }
+  const OxtsErrorStats kitti = MeasureOxtsError(drive.oxts, kitti_stamps_s);
+  EXPECT_NEAR(kitti.integrated_share, 0.0135, 0.001);  // 0.46 m over 34 m
+  EXPECT_LT(kitti.high_frequency_m, 0.005);
+  for (double white_m : {0.001, 0.01}) {
+    for (uint64_t seed : {1u, 2u, 3u}) {
+      SimulatorOptions options = SmallOptions(seed, 30);
+      options.oxts_error.position_white_m = white_m;
+      const Simulator sim(options);
+      std::vector<OxtsPacket> packets;
+      std::vector<double> stamps_s;
+      for (int i = 0; i < 30; ++i) {
+        packets.push_back(sim.SimulateOxts(i));
+        stamps_s.push_back(sim.Timing(i).oxts_time_s);
+      }
+      const OxtsErrorStats simulated = MeasureOxtsError(packets, stamps_s);
+      if (white_m < 0.005) {
+        EXPECT_LT(simulated.high_frequency_m, 0.005) << "seed " << seed;
+        EXPECT_GT(simulated.integrated_share, 0.1 * kitti.integrated_share) << "seed " << seed;
+        EXPECT_LT(simulated.integrated_share, 3 * kitti.integrated_share) << "seed " << seed;
+      } else {
+        EXPECT_GT(simulated.high_frequency_m, 0.008) << "seed " << seed;
+      }
+    }
+  }
+}
+
 TEST(NavigationError, DriftRateIsTheDerivativeAndSigmaIsAsSet) {
   NavigationErrorOptions options;
   std::mt19937_64 rng(7);
