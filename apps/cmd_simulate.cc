@@ -17,6 +17,11 @@ int RunSimulate() {
   options.dynamic_objects = FLAGS_dynamic_objects;
   options.lidar_hz = FLAGS_lidar_hz;
   options.oxts_error.position_white_m = FLAGS_oxts_white_position_m;
+  if (!(FLAGS_oxts_error_scale >= 0.0 && FLAGS_oxts_error_scale <= 10.0)) {
+    return UsageError("simulate", "--oxts_error_scale must be between 0 and 10, got " +
+                                      std::to_string(FLAGS_oxts_error_scale));
+  }
+  options.oxts_error = options.oxts_error.Scaled(FLAGS_oxts_error_scale);
   if (!sim::ParseSceneType(FLAGS_scene, &options.scene)) {
     return UsageError("simulate",
                       "--scene must be " + sim::SceneTypeChoices() + ", got '" + FLAGS_scene + "'");

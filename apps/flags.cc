@@ -25,6 +25,9 @@ DEFINE_double(lidar_hz, 10.0, "simulate: LiDAR spin rate = frame rate of every s
 DEFINE_double(oxts_white_position_m, 0.001,
               "simulate: σ of each oxts packet's own position noise per axis, on top of the "
               "smooth drift of a GPS/INS solution [m]; 0.01 stresses the local map");
+DEFINE_double(oxts_error_scale, 1.0,
+              "simulate: multiplies every σ of the oxts error, drift and white noise alike "
+              "(after --oxts_white_position_m); 0 = exact navigation, 2-3 = a poorer GPS/INS");
 DEFINE_string(detector, "canny", "image edges: canny | lsd | fld (cv::ximgproc FastLineDetector)");
 DEFINE_double(min_segment_px, 15, "lsd/fld: shorter segments are dropped as texture [px]");
 DEFINE_double(max_edge_density, 0.0,

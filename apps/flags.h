@@ -16,6 +16,7 @@ DECLARE_string(scene);
 DECLARE_string(camera);
 DECLARE_double(lidar_hz);
 DECLARE_double(oxts_white_position_m);
+DECLARE_double(oxts_error_scale);
 DECLARE_string(detector);
 DECLARE_double(min_segment_px);
 DECLARE_double(max_edge_density);

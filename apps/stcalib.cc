@@ -31,7 +31,7 @@ const std::vector<Subcommand>& Subcommands() {
       {"simulate",
        "--out=DIR [--frames=N (40)] [--seed=S (1)] [--time_offset_s=X (0)] "
        "[--dynamic_objects=K (6)] [--scene=urban|poles|open] [--lidar_hz=10] "
-       "[--camera=kitti|kitti_1003|hd720] [--oxts_white_position_m=0.001]",
+       "[--camera=kitti|kitti_1003|hd720] [--oxts_white_position_m=0.001] [--oxts_error_scale=1]",
        "a KITTI-raw drive with exact ground truth (extrinsic, time offset, motion, labels)",
        &RunSimulate},
       {"features", "--drive=DRIVE_DIR --frame=I --out=DIR [--calib_dir=DIR]",

@@ -522,7 +522,8 @@ TEST(Cli, SimulateRejectsBadFlags) {
         std::string("--lidar_hz=0"), std::string("--time_offset_s=3"),
         std::string("--dynamic_objects=-1"), std::string("--scene=forest"),
         std::string("--camera=fisheye"), std::string("--oxts_white_position_m=-0.01"),
-        std::string("--oxts_white_position_m=nan")}) {
+        std::string("--oxts_white_position_m=nan"), std::string("--oxts_error_scale=-1"),
+        std::string("--oxts_error_scale=nan")}) {
     const RunResult r = RunStcalib("simulate" + out + " " + flags);
     EXPECT_EQ(r.exit_code, 2) << flags << ": " << r.output;
     EXPECT_THAT(r.output, HasSubstr("usage error")) << flags;
@@ -532,6 +533,8 @@ TEST(Cli, SimulateRejectsBadFlags) {
               HasSubstr("--scene must be urban, poles or open, got 'forest'"));
   EXPECT_THAT(RunStcalib("simulate" + out + " --oxts_white_position_m=nan").output,
               HasSubstr("--oxts_white_position_m must be between 0 and 1 m, got nan"));
+  EXPECT_THAT(RunStcalib("simulate" + out + " --oxts_error_scale=11").output,
+              HasSubstr("--oxts_error_scale must be between 0 and 10, got 11"));
   EXPECT_THAT(RunStcalib("simulate" + out + " --camera=fisheye").output,
               HasSubstr("--camera must be kitti, kitti_1003 or hd720, got 'fisheye'"));
   EXPECT_FALSE(std::filesystem::exists(tmp.path() + "/o"));

@@ -241,6 +241,37 @@ TEST(Simulator, OxtsRelativeMotionMatchesTheTruth) {
   }
 }
 
+// With every σ scaled to 0 (`simulate --oxts_error_scale=0`) the packets are the truth: poses,
+// velocities and rates; scaled by 2 the drift doubles at the same periods.
+TEST(Simulator, OxtsErrorScaleZeroIsExactNavigation) {
+  SimulatorOptions options = SmallOptions(3, 10);
+  options.oxts_error = options.oxts_error.Scaled(0.0);
+  const Simulator sim(options);
+  for (int i = 0; i < 10; ++i) {
+    const OxtsPacket p = sim.SimulateOxts(i);
+    const double t = sim.Timing(i).oxts_time_s;
+    const Rigid3d truth = sim.trajectory().T_world_imu(t);
+    const Rigid3d pose = OxtsPose(sim.oxts_origin(), p);
+    EXPECT_LT((pose.translation() - truth.translation()).norm(), 1e-6) << "frame " << i;
+    EXPECT_LT(RotationErrorDeg(pose.linear(), truth.linear()), 1e-6) << "frame " << i;
+    // Velocity and body rate against central differences of the truth over ±1 ms.
+    const double h = 1e-3;
+    const Rigid3d before = sim.trajectory().T_world_imu(t - h);
+    const Rigid3d after = sim.trajectory().T_world_imu(t + h);
+    const Eigen::Vector3d v_world = (after.translation() - before.translation()) / (2 * h);
+    EXPECT_NEAR(p.ve, v_world.x(), 1e-3) << "frame " << i;
+    EXPECT_NEAR(p.vn, v_world.y(), 1e-3) << "frame " << i;
+    EXPECT_NEAR(p.vu, v_world.z(), 1e-3) << "frame " << i;
+    const Eigen::Vector3d w = LogSO3(before.linear().transpose() * after.linear()) / (2 * h);
+    EXPECT_NEAR(p.wx, w.x(), 1e-4) << "frame " << i;
+    EXPECT_NEAR(p.wz, w.z(), 1e-4) << "frame " << i;
+  }
+  const NavigationErrorOptions twice = NavigationErrorOptions().Scaled(2.0);
+  EXPECT_DOUBLE_EQ(twice.position_drift_m, 2 * NavigationErrorOptions().position_drift_m);
+  EXPECT_DOUBLE_EQ(twice.rate_white_radps, 2 * NavigationErrorOptions().rate_white_radps);
+  EXPECT_DOUBLE_EQ(twice.max_period_s, NavigationErrorOptions().max_period_s);
+}
+
 // The oxts error as the local map and the motion model feel it: how far the velocities,
 // integrated over the drive, end from the positions (a share of the path length), and the
 // high-frequency part of the gap between a position step and the velocities' step over it (RMS

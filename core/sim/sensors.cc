@@ -194,6 +194,16 @@ cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, c
   return image;
 }
 
+NavigationErrorOptions NavigationErrorOptions::Scaled(double factor) const {
+  NavigationErrorOptions o = *this;
+  for (double* sigma : {&o.position_drift_m, &o.angle_drift_rad, &o.velocity_drift_mps,
+                        &o.vertical_velocity_drift_mps, &o.position_white_m, &o.angle_white_rad,
+                        &o.velocity_white_mps, &o.acceleration_white_mps2, &o.rate_white_radps}) {
+    *sigma *= factor;
+  }
+  return o;
+}
+
 NavigationError::NavigationError(const NavigationErrorOptions& options, std::mt19937_64* rng)
     : options_(options) {
   // Periods log-uniform in [min, max]; equal amplitudes so that each axis has the set σ
@@ -262,12 +272,11 @@ OxtsPacket SynthesizeOxtsPacket(const SimTrajectory& trajectory, const OxtsOrigi
   const Eigen::Vector3d specific_force = a_world + Eigen::Vector3d(0, 0, kGravity);
 
   const NavigationErrorOptions& noise = error.options();
-  std::normal_distribution<double> n_angle(0, noise.angle_white_rad),
-      n_vel(0, noise.velocity_white_mps), n_pos(0, noise.position_white_m), n_acc(0, 0.05),
-      n_rate(0, 5e-4);
-  auto white = [&](std::normal_distribution<double>& n) {  // draws in x, y, z order
+  // Unit normals scaled by σ: a σ of 0 (exact navigation) is no valid normal_distribution.
+  std::normal_distribution<double> n_angle, n_vel, n_pos, n_acc, n_rate;
+  auto white = [&](std::normal_distribution<double>& n, double sigma) {  // x, y, z order
     Eigen::Vector3d v;
-    for (int i = 0; i < 3; ++i) v[i] = n(*rng);
+    for (int i = 0; i < 3; ++i) v[i] = sigma * n(*rng);
     return v;
   };
   OxtsPacket p;
@@ -276,18 +285,21 @@ OxtsPacket SynthesizeOxtsPacket(const SimTrajectory& trajectory, const OxtsOrigi
   const double x0 = scale * kEarthRadiusM * origin.lon_deg * M_PI / 180.0;
   const double y0 =
       scale * kEarthRadiusM * std::log(std::tan(M_PI * (90.0 + origin.lat_deg) / 360.0));
-  const Eigen::Vector3d position = T1.translation() + error.PositionDrift(t_s) + white(n_pos);
+  const Eigen::Vector3d position =
+      T1.translation() + error.PositionDrift(t_s) + white(n_pos, noise.position_white_m);
   p.lon = (position.x() + x0) / (scale * kEarthRadiusM) * 180.0 / M_PI;
   p.lat = 360.0 / M_PI * std::atan(std::exp((position.y() + y0) / (scale * kEarthRadiusM))) - 90.0;
   p.alt = origin.alt_m + position.z();
-  const Eigen::Vector3d attitude = rpy + error.AngleDrift(t_s) + white(n_angle);
+  const Eigen::Vector3d attitude =
+      rpy + error.AngleDrift(t_s) + white(n_angle, noise.angle_white_rad);
   p.roll = attitude.x();
   p.pitch = attitude.y();
   p.yaw = std::remainder(attitude.z(), 2 * M_PI);
   // The velocity carries the position drift's rate and a drift of its own; the heading frame is
   // the written yaw's.
-  const Eigen::Vector3d velocity =
-      v_world + error.PositionDriftRate(t_s) + error.VelocityDrift(t_s) + white(n_vel);
+  const Eigen::Vector3d velocity = v_world + error.PositionDriftRate(t_s) +
+                                   error.VelocityDrift(t_s) +
+                                   white(n_vel, noise.velocity_white_mps);
   p.vn = velocity.y();
   p.ve = velocity.x();
   const Eigen::Vector3d v_heading =
@@ -295,21 +307,24 @@ OxtsPacket SynthesizeOxtsPacket(const SimTrajectory& trajectory, const OxtsOrigi
   p.vf = v_heading.x();
   p.vl = v_heading.y();
   p.vu = v_heading.z();
-  const Eigen::Vector3d a_body = T1.linear().transpose() * specific_force;
-  p.ax = a_body.x() + n_acc(*rng);
-  p.ay = a_body.y() + n_acc(*rng);
-  p.az = a_body.z() + n_acc(*rng);
-  const Eigen::Vector3d a_heading = R_heading.transpose() * specific_force;
-  p.af = a_heading.x() + n_acc(*rng);
-  p.al = a_heading.y() + n_acc(*rng);
-  p.au = a_heading.z() + n_acc(*rng);
-  p.wx = w_body.x() + n_rate(*rng);
-  p.wy = w_body.y() + n_rate(*rng);
-  p.wz = w_body.z() + n_rate(*rng);
-  const Eigen::Vector3d w_heading = R_heading.transpose() * (T1.linear() * w_body);
-  p.wf = w_heading.x() + n_rate(*rng);
-  p.wl = w_heading.y() + n_rate(*rng);
-  p.wu = w_heading.z() + n_rate(*rng);
+  const double acc = noise.acceleration_white_mps2, rate = noise.rate_white_radps;
+  const Eigen::Vector3d a_body = T1.linear().transpose() * specific_force + white(n_acc, acc);
+  p.ax = a_body.x();
+  p.ay = a_body.y();
+  p.az = a_body.z();
+  const Eigen::Vector3d a_heading = R_heading.transpose() * specific_force + white(n_acc, acc);
+  p.af = a_heading.x();
+  p.al = a_heading.y();
+  p.au = a_heading.z();
+  const Eigen::Vector3d w = w_body + white(n_rate, rate);
+  p.wx = w.x();
+  p.wy = w.y();
+  p.wz = w.z();
+  const Eigen::Vector3d w_heading =
+      R_heading.transpose() * (T1.linear() * w_body) + white(n_rate, rate);
+  p.wf = w_heading.x();
+  p.wl = w_heading.y();
+  p.wu = w_heading.z();
   p.pos_accuracy = 0.05;
   p.vel_accuracy = 0.02;
   p.navstat = 4;

@@ -80,6 +80,11 @@ struct NavigationErrorOptions {
   double position_white_m = 0.001;      ///< σ of each packet's own position noise, per axis [m]
   double angle_white_rad = 2e-5;        ///< σ of each packet's own attitude noise [rad]
   double velocity_white_mps = 0.02;     ///< σ of each packet's own velocity noise, per axis [m/s]
+  double acceleration_white_mps2 = 0.05;  ///< σ of each packet's acceleration noise [m/s²]
+  double rate_white_radps = 5e-4;         ///< σ of each packet's angular-rate noise [rad/s]
+
+  // Every σ above times `factor` (the periods unchanged): 0 is exact navigation.
+  NavigationErrorOptions Scaled(double factor) const;
 };
 
 class NavigationError {
