@@ -131,6 +131,7 @@ CalibrateJob CalibrateJobFromFlags() {
   o.refine.max_points_per_frame = FLAGS_max_points_per_frame;
   o.refine.max_iterations = FLAGS_refine_max_iterations;
   o.refine_frames = FLAGS_refine_frames;
+  o.refine_map_sweeps = FLAGS_refine_map_sweeps;
   o.tracking_gain = FLAGS_tracking_gain;
   o.refined_score_tolerance = FLAGS_refined_score_tolerance;
   o.tracking_update_every = FLAGS_tracking_update_every;

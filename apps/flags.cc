@@ -84,6 +84,8 @@ DEFINE_double(prior_sigma_forward_m, kOnline.refine.prior_sigma_forward_m,
 DEFINE_double(prior_sigma_time_s, kOnline.refine.prior_sigma_time_s,
               "search and refine: time-offset prior around δ0 [s]");
 DEFINE_int32(refine_frames, kOnline.refine_frames, "calibrate: latest frames in the refinement");
+DEFINE_int32(refine_map_sweeps, kOnline.refine_map_sweeps,
+             "calibrate: the refinement reads each local map's latest N sweeps (0 = all)");
 DEFINE_int32(refine_max_iterations, kOnline.refine.max_iterations,
              "refine: at most this many Ceres iterations per refinement");
 DEFINE_int32(max_points_per_frame, kOnline.refine.max_points_per_frame,

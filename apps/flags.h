@@ -44,6 +44,7 @@ DECLARE_double(prior_sigma_translation_m);
 DECLARE_double(prior_sigma_forward_m);
 DECLARE_double(prior_sigma_time_s);
 DECLARE_int32(refine_frames);
+DECLARE_int32(refine_map_sweeps);
 DECLARE_int32(max_points_per_frame);
 DECLARE_int32(refine_max_iterations);
 DECLARE_double(tracking_gain);

@@ -333,12 +333,15 @@ TEST(LocalMap, EarlierSweepsArePlacedAtTheTimeOffsetToFirstOrder) {
     edges->kind.push_back(EdgeKind::kVertical);
     edges->source_index.push_back(7);
     edges->offset_rate.push_back(Eigen::Vector3d::Zero());
+    edges->sweep_age.push_back(0);
     edges->fold.push_back(0);
   }
   const Rigid3d T = RelativeLidarPose(motion, 2.0, 1.8);
   Eigen::Matrix<double, 3, 4> rate = RelativeLidarPoseRate(motion, 2.0, 1.8);
-  const LidarEdges map = MergeEdges(current, {{&earlier, T, rate}});
+  const LidarEdges map = MergeEdges(current, {{&earlier, T, rate, 2}});
   ASSERT_EQ(map.size(), 2u);
+  EXPECT_EQ(map.sweep_age[0], 0);  // the current sweep's own point
+  EXPECT_EQ(map.sweep_age[1], 2);
   EXPECT_EQ(map.offset_rate[0], Eigen::Vector3d::Zero());
   const Eigen::Vector3d p = earlier.points_lidar[0];
   EXPECT_LT((map.points_lidar[1] - T * p).norm(), 1e-12);

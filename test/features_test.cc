@@ -591,6 +591,7 @@ TEST(LidarEdges, SelectAndAppendCarryEveryField) {
     edges.source_index.push_back(100 + i);
     edges.offset_rate.push_back(Eigen::Vector3d(0, 0, i));
     edges.fold.push_back(i == 3 ? 1 : 0);
+    edges.sweep_age.push_back(0);
   }
   LidarEdges picked = edges.Select({3, 0});
   picked.Append(edges.Select({1}));

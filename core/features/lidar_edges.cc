@@ -21,6 +21,7 @@ void ForEachPointField(To &to, const LidarEdges &from, F f) {
   f(to.source_index, from.source_index);
   f(to.offset_rate, from.offset_rate);
   f(to.fold, from.fold);
+  f(to.sweep_age, from.sweep_age);
 }
 
 void CheckPointFields(const LidarEdges &edges) {
@@ -152,6 +153,7 @@ LidarEdges ExtractLidarEdges(const LidarScan &scan, const ScanRings &rings,
     edges.source_index.push_back(i);
     edges.offset_rate.push_back(Eigen::Vector3d::Zero());
     edges.fold.push_back(fold ? 1 : 0);
+    edges.sweep_age.push_back(0);
   };
 
   // Vertical edges: along each ring, returns in azimuth order.

@@ -81,6 +81,8 @@ struct LidarEdges {
   // local map's earlier sweeps, RelativeLidarPoseRate); zero in a sweep's own edges.
   std::vector<Eigen::Vector3d> offset_rate;
   std::vector<uint8_t> fold;  ///< 1: a fold (LidarEdgeOptions::fold_height_tolerance_m)
+  // Sweeps between the point's and the local map's own (MergeEdges); 0 in a sweep's own edges.
+  std::vector<uint8_t> sweep_age;
 
   size_t size() const { return points_lidar.size(); }
   bool empty() const { return points_lidar.empty(); }

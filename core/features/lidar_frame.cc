@@ -199,6 +199,7 @@ LidarEdges MergeEdges(const LidarEdges& current, const std::vector<SweepInMap>& 
                              sweep.offset_rate.leftCols<3>() * p + sweep.offset_rate.col(3);
       moved.points_lidar[i] = T * p;
       moved.source_index[i] = -1;
+      moved.sweep_age[i] = static_cast<uint8_t>(std::clamp(sweep.age, 0, 255));
     }
     map.Append(moved);
   }
@@ -226,6 +227,7 @@ Status SweepCache::LocalMap(size_t frame, const LocalMapOptions& map_options, Li
   STCALIB_RETURN_IF_ERROR(Finished(frame, &current_features));
   const LidarFrameFeatures& current = *current_features;
   std::vector<const LidarFrameFeatures*> sweeps;
+  std::vector<int> ages;  // frames before `frame`
   for (size_t k = first; k < frame; ++k) {
     const LidarFrameFeatures* f;
     const Status status = Finished(k, &f);
@@ -236,6 +238,7 @@ Status SweepCache::LocalMap(size_t frame, const LocalMapOptions& map_options, Li
       continue;
     }
     sweeps.push_back(f);
+    ages.push_back(static_cast<int>(frame - k));
   }
   sweeps.push_back(current_features);
   std::vector<SweepInMap> previous;
@@ -259,6 +262,7 @@ Status SweepCache::LocalMap(size_t frame, const LocalMapOptions& map_options, Li
     // Poses from the oxts, looked up at the LiDAR stamps, are off with δ; NDT and a motion from
     // scan registration relate the sweeps themselves, so their relative pose holds at any δ.
     SweepInMap sweep{&sweeps[k]->edges, T};
+    sweep.age = ages[k];
     if (!map_options.use_ndt && motion_.source() == DriveMotion::Source::kOxts) {
       sweep.offset_rate =
           RelativeLidarPoseRate(motion_.PoseFunction(), current.stamp_s, sweeps[k]->stamp_s);

@@ -116,6 +116,7 @@ struct SweepInMap {
   const LidarEdges* edges = nullptr;
   Rigid3d T_current_previous = Rigid3d::Identity();
   Eigen::Matrix<double, 3, 4> offset_rate = Eigen::Matrix<double, 3, 4>::Zero();
+  int age = 1;  ///< frames before the current sweep (LidarEdges::sweep_age, at most 255)
 };
 
 // Merges `previous` into `current`; a merged point's offset_rate is ∂(T·p)/∂δ.

@@ -107,6 +107,7 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   out->kinds = std::move(map.kind);
   out->offset_rates = std::move(map.offset_rate);
   out->folds = std::move(map.fold);
+  out->sweep_ages = std::move(map.sweep_age);
 
   const double lidar_s = motion_.Seconds(drive_->lidar_stamps_ns[frame]);
   out->e0_s = lidar_s - camera_s;

@@ -43,6 +43,7 @@ Status OnlineCalibratorOptions::Validate() const {
   if (!(refined_score_tolerance >= 0 && refined_score_tolerance < 1)) {
     return Status::Error("online: refined_score_tolerance must be in [0, 1)");
   }
+  if (refine_map_sweeps < 0) return Status::Error("online: refine_map_sweeps must be >= 0");
   if (tracking_update_every < 1) {
     return Status::Error("online: tracking_update_every must be >= 1");
   }
@@ -111,18 +112,21 @@ OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
   fold_free_options_ = WithSharedSettings(fold_free);
 }
 
-const std::shared_ptr<const CalibrationFrame>& OnlineCalibrator::InUse(
-    const WindowFrame& frame) const {
+const std::shared_ptr<const CalibrationFrame>& OnlineCalibrator::InUse(const WindowFrame& frame,
+                                                                       bool refine) const {
   const bool drop = options_.folds == OnlineCalibratorOptions::Folds::kDrop || folds_dropped_;
+  if (refine) return drop ? frame.refine_without_folds : frame.refine_all;
   return drop ? frame.without_folds : frame.all;
 }
 
-std::vector<const CalibrationFrame*> OnlineCalibrator::LatestFrames(int count,
-                                                                    bool with_folds) const {
+std::vector<const CalibrationFrame*> OnlineCalibrator::LatestFrames(int count, bool with_folds,
+                                                                    bool refine) const {
   std::vector<const CalibrationFrame*> frames;
   const size_t n = std::min<size_t>(window_.size(), count);
   for (size_t k = window_.size() - n; k < window_.size(); ++k) {
-    frames.push_back(with_folds ? window_[k].all.get() : InUse(window_[k]).get());
+    const WindowFrame& frame = window_[k];
+    frames.push_back(with_folds ? (refine ? frame.refine_all : frame.all).get()
+                                : InUse(frame, refine).get());
   }
   return frames;
 }
@@ -162,7 +166,7 @@ FrameReport OnlineCalibrator::SkipFrame(int frame, const std::string& why) const
 }
 
 std::vector<const CalibrationFrame*> OnlineCalibrator::RefineWindow() const {
-  return LatestFrames(options_.refine_frames);
+  return LatestFrames(options_.refine_frames, /*with_folds=*/false, /*refine=*/true);
 }
 
 std::string OnlineCalibrator::RefusalReason(const CalibrationFrame& frame) const {
@@ -204,6 +208,9 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   in_window.without_folds = options_.folds == OnlineCalibratorOptions::Folds::kKeep
                                 ? in_window.all
                                 : WithoutFolds(in_window.all);
+  in_window.refine_all = LatestSweepsOnly(in_window.all, options_.refine_map_sweeps);
+  in_window.refine_without_folds =
+      LatestSweepsOnly(in_window.without_folds, options_.refine_map_sweeps);
   window_.push_back(std::move(in_window));
   while (static_cast<int>(window_.size()) >
          std::max(options_.window_frames, options_.refine_frames)) {
@@ -245,8 +252,9 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
                          (options_.coarse_until_window_full &&
                           static_cast<int>(frames.size()) < options_.window_frames);
   const std::vector<const CalibrationFrame*> refine_frames = RefineWindow();
-  // The refinement's frames: the grid's window and the judge of the candidates.
-  WindowScorer long_scorer(refine_frames, ScoreOptionsInUse());
+  // The refinement's frames, every point of their maps: the grid's window and the judge of the
+  // candidates.
+  WindowScorer long_scorer(LatestFrames(options_.refine_frames), ScoreOptionsInUse());
   AdaptiveGridSearchOptions search_options = options_.search;
   Search(&scorer, &long_scorer, &search_options, &report);
 

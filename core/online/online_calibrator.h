@@ -23,6 +23,10 @@ struct OnlineCalibratorOptions {
   // acquisition ends only when the grid agrees with the estimate on a full refinement window:
   // drives shorter than about refine_frames + 5 frames want fewer.)
   int refine_frames = 20;  ///< the refinement uses this many latest frames
+  // The refinement reads the points of each frame's latest refine_map_sweeps sweeps only (its
+  // own first; 0 = the whole local map, FrameSourceOptions::local_map). The search and the score
+  // read the whole map.
+  int refine_map_sweeps = 0;
   // score.horizontal_weight, refine.horizontal_weight and both time_offset_bound_s are set from
   // the fields below (one setting, one home) by WithSharedSettings, which the calibrator applies.
   ScoreOptions score;
@@ -334,11 +338,16 @@ class OnlineCalibrator {
   // (the same frame with Folds::kKeep).
   struct WindowFrame {
     std::shared_ptr<const CalibrationFrame> all, without_folds;
+    // The same two for the refinement (OnlineCalibratorOptions::refine_map_sweeps).
+    std::shared_ptr<const CalibrationFrame> refine_all, refine_without_folds;
   };
-  // The version of `frame` the calibrator reads now (OnlineCalibratorOptions::folds).
-  const std::shared_ptr<const CalibrationFrame>& InUse(const WindowFrame& frame) const;
+  // The version of `frame` the calibrator reads now (OnlineCalibratorOptions::folds), for the
+  // search and score or for the refinement.
+  const std::shared_ptr<const CalibrationFrame>& InUse(const WindowFrame& frame,
+                                                       bool refine = false) const;
   // The latest `count` frames as read now, or with every point (folds included).
-  std::vector<const CalibrationFrame*> LatestFrames(int count, bool with_folds = false) const;
+  std::vector<const CalibrationFrame*> LatestFrames(int count, bool with_folds = false,
+                                                    bool refine = false) const;
   std::deque<WindowFrame> window_;  // the last refine_frames frames
   // The rotation grid's per-frame scores: while acquiring the grid runs on a window that grows
   // by one frame, and each frame is scored once as long as the translation and δ stay put.

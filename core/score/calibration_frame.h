@@ -26,6 +26,9 @@ struct CalibrationFrame {
   std::vector<Eigen::Vector3d> offset_rates;
   // 1: the point is a fold (LidarEdges::fold); empty: none is.
   std::vector<uint8_t> folds;
+  // Frames between the sweep of each point and this frame's own (LidarEdges::sweep_age); empty:
+  // all from its own.
+  std::vector<uint8_t> sweep_ages;
   ImageFeatures image;  ///< distance_raw_px for overlays
   // Maps per edge kind, indexed by EdgeKind (0 vertical, 1 horizontal): with oriented maps a
   // vertical LiDAR edge reads the map of near-vertical image edges only; otherwise both entries

@@ -314,17 +314,20 @@ template <typename Keep>
 std::shared_ptr<const CalibrationFrame> KeepPoints(const CalibrationFrame& frame, Keep keep) {
   CHECK(frame.offset_rates.empty() || frame.offset_rates.size() == frame.size());
   CHECK(frame.folds.empty() || frame.folds.size() == frame.size());
+  CHECK(frame.sweep_ages.empty() || frame.sweep_ages.size() == frame.size());
   auto kept = std::make_shared<CalibrationFrame>(frame);
   kept->points_lidar.clear();
   kept->kinds.clear();
   kept->offset_rates.clear();
   kept->folds.clear();
+  kept->sweep_ages.clear();
   for (size_t i = 0; i < frame.size(); ++i) {
     if (!keep(i)) continue;
     kept->points_lidar.push_back(frame.points_lidar[i]);
     kept->kinds.push_back(frame.kinds[i]);
     if (!frame.offset_rates.empty()) kept->offset_rates.push_back(frame.offset_rates[i]);
     if (!frame.folds.empty()) kept->folds.push_back(frame.folds[i]);
+    if (!frame.sweep_ages.empty()) kept->sweep_ages.push_back(frame.sweep_ages[i]);
   }
   return kept;
 }
@@ -348,6 +351,16 @@ std::shared_ptr<const CalibrationFrame> WithoutFolds(
   CHECK(frame != nullptr);
   if (std::find(frame->folds.begin(), frame->folds.end(), 1) == frame->folds.end()) return frame;
   return KeepPoints(*frame, [&](size_t i) { return frame->folds[i] == 0; });
+}
+
+std::shared_ptr<const CalibrationFrame> LatestSweepsOnly(
+    std::shared_ptr<const CalibrationFrame> frame, int sweeps) {
+  CHECK(frame != nullptr);
+  auto old = [&](uint8_t age) { return static_cast<int>(age) >= sweeps; };
+  if (sweeps <= 0 || std::none_of(frame->sweep_ages.begin(), frame->sweep_ages.end(), old)) {
+    return frame;
+  }
+  return KeepPoints(*frame, [&](size_t i) { return !old(frame->sweep_ages[i]); });
 }
 
 bool HealthSetting::operator==(const HealthSetting& o) const {

@@ -93,6 +93,10 @@ std::shared_ptr<const CalibrationFrame> PruneToImage(const CalibrationFrame& fra
                                                      const CalibrationState& state, double margin);
 // The frame without its folds (CalibrationFrame::folds): the same frame when it has none.
 std::shared_ptr<const CalibrationFrame> WithoutFolds(std::shared_ptr<const CalibrationFrame> frame);
+// The frame with the points of its local map's latest `sweeps` sweeps only
+// (CalibrationFrame::sweep_ages): the same frame when it has no older one or `sweeps` <= 0.
+std::shared_ptr<const CalibrationFrame> LatestSweepsOnly(
+    std::shared_ptr<const CalibrationFrame> frame, int sweeps);
 
 // What the health score's per-frame scores depend on besides the frame. With a
 // HealthScoreCache, an online calibrator whose estimate did not move since the last frame scores
