@@ -717,6 +717,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   empty->kinds.clear();
   empty->offset_rates.clear();
   empty->folds.clear();
+  empty->sweep_ages.clear();
   OnlineCalibratorOptions single;
   single.window_frames = 1;
   single.refine_frames = 1;
