@@ -209,8 +209,11 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
                                 ? in_window.all
                                 : WithoutFolds(in_window.all);
   in_window.refine_all = LatestSweepsOnly(in_window.all, options_.refine_map_sweeps);
+  // With Folds::kKeep both are one frame: restrict it once.
   in_window.refine_without_folds =
-      LatestSweepsOnly(in_window.without_folds, options_.refine_map_sweeps);
+      in_window.without_folds == in_window.all
+          ? in_window.refine_all
+          : LatestSweepsOnly(in_window.without_folds, options_.refine_map_sweeps);
   window_.push_back(std::move(in_window));
   while (static_cast<int>(window_.size()) >
          std::max(options_.window_frames, options_.refine_frames)) {

@@ -196,11 +196,7 @@ cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, c
 
 NavigationErrorOptions NavigationErrorOptions::Scaled(double factor) const {
   NavigationErrorOptions o = *this;
-  for (double* sigma : {&o.position_drift_m, &o.angle_drift_rad, &o.velocity_drift_mps,
-                        &o.vertical_velocity_drift_mps, &o.position_white_m, &o.angle_white_rad,
-                        &o.velocity_white_mps, &o.acceleration_white_mps2, &o.rate_white_radps}) {
-    *sigma *= factor;
-  }
+  for (double* sigma : o.Sigmas()) *sigma *= factor;
   return o;
 }
 

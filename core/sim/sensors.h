@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <random>
+#include <type_traits>
 #include <vector>
 
 #include "core/io/oxts.h"
@@ -85,6 +86,20 @@ struct NavigationErrorOptions {
 
   // Every σ above times `factor` (the periods unchanged): 0 is exact navigation.
   NavigationErrorOptions Scaled(double factor) const;
+  // Every σ above: the one list that Scaled and SimulatorOptions::Validate walk.
+  std::array<double*, 9> Sigmas() { return SigmasOf(*this); }
+  std::array<const double*, 9> Sigmas() const { return SigmasOf(*this); }
+
+ private:
+  template <typename Self>
+  static std::array<std::conditional_t<std::is_const_v<Self>, const double*, double*>, 9> SigmasOf(
+      Self& o) {
+    return {&o.position_drift_m,   &o.angle_drift_rad,
+            &o.velocity_drift_mps, &o.vertical_velocity_drift_mps,
+            &o.position_white_m,   &o.angle_white_rad,
+            &o.velocity_white_mps, &o.acceleration_white_mps2,
+            &o.rate_white_radps};
+  }
 };
 
 class NavigationError {

@@ -165,11 +165,9 @@ Status SimulatorOptions::Validate() const {
     return Status::Error("--oxts_white_position_m must be between 0 and 1 m, got " +
                          std::to_string(e.position_white_m));
   }
-  for (double sigma :
-       {e.position_drift_m, e.angle_drift_rad, e.velocity_drift_mps, e.vertical_velocity_drift_mps,
-        e.angle_white_rad, e.velocity_white_mps, e.acceleration_white_mps2, e.rate_white_radps}) {
-    if (!(sigma >= 0.0 && sigma <= 10.0)) {
-      return Status::Error("oxts noise σ must be between 0 and 10, got " + std::to_string(sigma));
+  for (const double* sigma : e.Sigmas()) {
+    if (!(*sigma >= 0.0 && *sigma <= 10.0)) {
+      return Status::Error("oxts noise σ must be between 0 and 10, got " + std::to_string(*sigma));
     }
   }
   if (!(e.min_period_s > 0.0 && e.max_period_s >= e.min_period_s && e.velocity_min_period_s > 0.0 &&
