@@ -713,11 +713,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
 
   // A frame with no LiDAR edges: the estimate is kept and the report says why.
   auto empty = std::make_shared<CalibrationFrame>(*frames.back());
-  empty->points_lidar.clear();
-  empty->kinds.clear();
-  empty->offset_rates.clear();
-  empty->folds.clear();
-  empty->sweep_ages.clear();
+  empty->ClearPoints();
   OnlineCalibratorOptions single;
   single.window_frames = 1;
   single.refine_frames = 1;

@@ -103,11 +103,7 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   LidarEdges map;
   LocalMapStats stats;
   STCALIB_RETURN_IF_ERROR(cache_->LocalMap(frame, options_.local_map, &map, &stats));
-  out->points_lidar = std::move(map.points_lidar);
-  out->kinds = std::move(map.kind);
-  out->offset_rates = std::move(map.offset_rate);
-  out->folds = std::move(map.fold);
-  out->sweep_ages = std::move(map.sweep_age);
+  out->TakePoints(std::move(map));
 
   const double lidar_s = motion_.Seconds(drive_->lidar_stamps_ns[frame]);
   out->e0_s = lidar_s - camera_s;

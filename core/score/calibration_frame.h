@@ -13,23 +13,14 @@
 
 namespace stcalib {
 
-// One image with its LiDAR edge points: everything the score, the search and the refinement read.
-struct CalibrationFrame {
+// Everything of a frame but its LiDAR edge points: the image, its maps, the stamps and the motion.
+struct FrameImageAndMotion {
   int index = 0;             ///< frame of the drive
   double e0_s = 0;           ///< LiDAR stamp − camera stamp [s]; the gap is e = e0 + δ
   double camera_time_s = 0;  ///< image stamp on the drive's clock [s] (frames must advance)
   LidarTwist twist;          ///< LiDAR body twist at the image time (motion model, method.md §3)
   CameraModel camera;        ///< size read from the image
-  std::vector<Eigen::Vector3d> points_lidar;  ///< edge points (local map), at the LiDAR stamp
-  std::vector<EdgeKind> kinds;
-  // ∂p/∂δ [m/s] (LidarEdges::offset_rate), read by the refinement; empty: all zero.
-  std::vector<Eigen::Vector3d> offset_rates;
-  // 1: the point is a fold (LidarEdges::fold); empty: none is.
-  std::vector<uint8_t> folds;
-  // Frames between the sweep of each point and this frame's own (LidarEdges::sweep_age); empty:
-  // all from its own.
-  std::vector<uint8_t> sweep_ages;
-  ImageFeatures image;  ///< distance_raw_px for overlays
+  ImageFeatures image;       ///< distance_raw_px for overlays
   // Maps per edge kind, indexed by EdgeKind (0 vertical, 1 horizontal): with oriented maps a
   // vertical LiDAR edge reads the map of near-vertical image edges only; otherwise both entries
   // share the same map.
@@ -43,8 +34,32 @@ struct CalibrationFrame {
   // The largest value of the two distance maps: the residual of a point outside the image [px];
   // 0 = not yet known (the refinement then finds it).
   double distance_cap_px = 0;
+};
+
+// One image with its LiDAR edge points: everything the score, the search and the refinement read.
+// The per-point fields are the ones below; ClearPoints, TakePoints and WithPoints are the only
+// code that lists them, so a new one is added there and nowhere else.
+struct CalibrationFrame : FrameImageAndMotion {
+  std::vector<Eigen::Vector3d> points_lidar;  ///< edge points (local map), at the LiDAR stamp
+  std::vector<EdgeKind> kinds;
+  // ∂p/∂δ [m/s] (LidarEdges::offset_rate), read by the refinement; empty: all zero.
+  std::vector<Eigen::Vector3d> offset_rates;
+  // 1: the point is a fold (LidarEdges::fold); empty: none is.
+  std::vector<uint8_t> folds;
+  // Frames between the sweep of each point and this frame's own (LidarEdges::sweep_age); empty:
+  // all from its own.
+  std::vector<uint8_t> sweep_ages;
 
   size_t size() const { return points_lidar.size(); }
+  // Whether every optional per-point field is empty or has an entry per point.
+  bool PointFieldsConsistent() const;
+  void ClearPoints();
+  // The points of a local map, moved out of `edges` (its capture times and scan indices are not
+  // kept).
+  void TakePoints(LidarEdges&& edges);
+  // The same image and maps with the points at `indices` only (in that order), each with its
+  // per-point entries; the points are copied, nothing else is (the maps share their data).
+  CalibrationFrame WithPoints(const std::vector<size_t>& indices) const;
 };
 
 // Pixel of edge point i of `frame` at `state` (carried by the motion model over e0 + δ, then
@@ -56,6 +71,44 @@ inline bool ProjectFramePoint(const CalibrationFrame& frame, const CalibrationSt
                                                       frame.points_lidar[i]);
   double depth;
   return frame.camera.Project(p, pixel, &depth);
+}
+
+inline bool CalibrationFrame::PointFieldsConsistent() const {
+  const size_t n = size();
+  return kinds.size() == n && (offset_rates.empty() || offset_rates.size() == n) &&
+         (folds.empty() || folds.size() == n) && (sweep_ages.empty() || sweep_ages.size() == n);
+}
+
+inline void CalibrationFrame::ClearPoints() {
+  points_lidar.clear();
+  kinds.clear();
+  offset_rates.clear();
+  folds.clear();
+  sweep_ages.clear();
+}
+
+inline void CalibrationFrame::TakePoints(LidarEdges&& edges) {
+  points_lidar = std::move(edges.points_lidar);
+  kinds = std::move(edges.kind);
+  offset_rates = std::move(edges.offset_rate);
+  folds = std::move(edges.fold);
+  sweep_ages = std::move(edges.sweep_age);
+}
+
+inline CalibrationFrame CalibrationFrame::WithPoints(const std::vector<size_t>& indices) const {
+  CalibrationFrame out;
+  static_cast<FrameImageAndMotion&>(out) = *this;
+  auto pick = [&](const auto& from, auto* to) {
+    if (from.empty()) return;
+    to->reserve(indices.size());
+    for (size_t i : indices) to->push_back(from[i]);
+  };
+  pick(points_lidar, &out.points_lidar);
+  pick(kinds, &out.kinds);
+  pick(offset_rates, &out.offset_rates);
+  pick(folds, &out.folds);
+  pick(sweep_ages, &out.sweep_ages);
+  return out;
 }
 
 }  // namespace stcalib

@@ -312,24 +312,13 @@ namespace {
 // `frame` with the points for which `keep(i)` holds, their per-point entries kept with them.
 template <typename Keep>
 std::shared_ptr<const CalibrationFrame> KeepPoints(const CalibrationFrame& frame, Keep keep) {
-  CHECK(frame.offset_rates.empty() || frame.offset_rates.size() == frame.size());
-  CHECK(frame.folds.empty() || frame.folds.size() == frame.size());
-  CHECK(frame.sweep_ages.empty() || frame.sweep_ages.size() == frame.size());
-  auto kept = std::make_shared<CalibrationFrame>(frame);
-  kept->points_lidar.clear();
-  kept->kinds.clear();
-  kept->offset_rates.clear();
-  kept->folds.clear();
-  kept->sweep_ages.clear();
+  CHECK(frame.PointFieldsConsistent());
+  std::vector<size_t> indices;
+  indices.reserve(frame.size());
   for (size_t i = 0; i < frame.size(); ++i) {
-    if (!keep(i)) continue;
-    kept->points_lidar.push_back(frame.points_lidar[i]);
-    kept->kinds.push_back(frame.kinds[i]);
-    if (!frame.offset_rates.empty()) kept->offset_rates.push_back(frame.offset_rates[i]);
-    if (!frame.folds.empty()) kept->folds.push_back(frame.folds[i]);
-    if (!frame.sweep_ages.empty()) kept->sweep_ages.push_back(frame.sweep_ages[i]);
+    if (keep(i)) indices.push_back(i);
   }
-  return kept;
+  return std::make_shared<const CalibrationFrame>(frame.WithPoints(indices));
 }
 
 }  // namespace
