@@ -121,8 +121,10 @@ CalibrateJob CalibrateJobFromFlags() {
   o.search.translation_prior_sigma_m = FLAGS_prior_sigma_translation_m;
   o.search.time_offset_prior_sigma_s = FLAGS_prior_sigma_time_s;
   o.refine.estimate_time_offset = FLAGS_estimate_time_offset;
-  o.refine.loss =
-      FLAGS_loss == "huber" ? RefineOptions::Loss::kHuber : RefineOptions::Loss::kCauchy;
+  ParseLoss(FLAGS_loss, &o.refine.loss);  // CalibrateFlagsError checked both names
+  ParseLoss(FLAGS_acquired_loss, &o.acquired_loss);
+  o.acquired_loss_scale_px = FLAGS_acquired_loss_scale_px;
+  o.acquired_loss_when_tracking = FLAGS_acquired_loss_when_tracking;
   o.refine.loss_scale_px = FLAGS_loss_scale_px;
   o.refine.prior_sigma_rotation_deg = FLAGS_prior_sigma_rotation_deg;
   o.refine.prior_sigma_translation_m = FLAGS_prior_sigma_translation_m;
@@ -527,7 +529,11 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
 }
 
 std::string CalibrateFlagsError() {
-  if (FLAGS_loss != "cauchy" && FLAGS_loss != "huber") return "--loss must be cauchy or huber";
+  for (const auto& [name, value] :
+       {std::pair{"--loss", &FLAGS_loss}, std::pair{"--acquired_loss", &FLAGS_acquired_loss}}) {
+    RefineOptions::Loss loss;
+    if (!ParseLoss(*value, &loss)) return std::string(name) + " must be huber, cauchy or tukey";
+  }
   OnlineCalibratorOptions::Folds folds;
   if (!ParseFolds(FLAGS_lidar_folds, &folds)) {
     return "--lidar_folds must be " + FoldsChoices();

@@ -55,7 +55,8 @@ DEFINE_int32(window_frames, kOnline.window_frames,
 DEFINE_double(time_offset_bound_s, kOnline.time_offset_bound_s, "calibrate: |δ| bound [s]");
 DEFINE_bool(estimate_time_offset, kOnline.refine.estimate_time_offset,
             "calibrate: estimate δ (false: keep δ0)");
-DEFINE_string(loss, "cauchy", "calibrate: robust loss, cauchy | huber");
+DEFINE_string(loss, LossName(kOnline.refine.loss),
+              "calibrate: robust loss while acquiring, huber | cauchy | tukey");
 // Refinement from drive 0013's calibration over frames 0-29: 0.27 deg at 1 px, 0.35 at 3 px.
 DEFINE_double(loss_scale_px, kOnline.refine.loss_scale_px, "calibrate: robust-loss scale [px]");
 DEFINE_double(horizontal_weight, kOnline.horizontal_weight,
@@ -103,6 +104,12 @@ DEFINE_double(observable_translation_m, kOnline.refine.observable_translation_m,
               "refine: a translation axis is observable below this std [m]");
 DEFINE_double(observable_time_s, kOnline.refine.observable_time_s,
               "refine: δ is observable below this std [s]");
+DEFINE_string(acquired_loss, LossName(kOnline.acquired_loss),
+              "calibrate: robust loss once acquired (tracking and polish), huber | cauchy | tukey");
+DEFINE_double(acquired_loss_scale_px, kOnline.acquired_loss_scale_px,
+              "calibrate: scale of --acquired_loss [px]");
+DEFINE_bool(acquired_loss_when_tracking, kOnline.acquired_loss_when_tracking,
+            "calibrate: --acquired_loss in tracking updates too (else in the polish only)");
 DEFINE_double(polish_forward_std_m, kOnline.polish_forward_std_m,
               "calibrate: the polish moves δ with the forward translation only below this "
               "forward std [m]");

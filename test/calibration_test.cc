@@ -170,6 +170,41 @@ TEST(OnlineCalibrator, FoldsInTheWindowFollowTheOption) {
   EXPECT_EQ(parsed, OnlineCalibratorOptions::Folds::kDropWhenTracking);
 }
 
+// The refinement's loss: refine.loss while acquiring, acquired_loss once acquired (with no
+// rotation grid there is no acquisition); the names parse both ways.
+TEST(OnlineCalibrator, AcquiredLossOnceAcquired) {
+  OnlineCalibratorOptions options;
+  options.refine.loss = RefineOptions::Loss::kCauchy;
+  options.refine.loss_scale_px = 1.0;
+  options.acquired_loss = RefineOptions::Loss::kTukey;
+  options.acquired_loss_scale_px = 5.0;
+  ASSERT_GT(options.lost_grid_deg, 0);
+  const OnlineCalibrator acquiring(options, CalibrationState());
+  ASSERT_TRUE(acquiring.acquiring());
+  EXPECT_EQ(acquiring.RefineOptionsInUse().loss, RefineOptions::Loss::kCauchy);
+  EXPECT_EQ(acquiring.RefineOptionsInUse(/*polish=*/true).loss_scale_px, 1.0);
+  options.lost_grid_deg = 0;
+  const OnlineCalibrator acquired(options, CalibrationState());
+  ASSERT_FALSE(acquired.acquiring());
+  EXPECT_EQ(acquired.RefineOptionsInUse().loss, RefineOptions::Loss::kTukey);
+  EXPECT_EQ(acquired.RefineOptionsInUse().loss_scale_px, 5.0);
+  options.acquired_loss_when_tracking = false;
+  const OnlineCalibrator polish_only(options, CalibrationState());
+  EXPECT_EQ(polish_only.RefineOptionsInUse().loss, RefineOptions::Loss::kCauchy);
+  EXPECT_EQ(polish_only.RefineOptionsInUse(/*polish=*/true).loss, RefineOptions::Loss::kTukey);
+  options.acquired_loss_scale_px = 0;
+  EXPECT_FALSE(options.Validate().ok());
+  for (RefineOptions::Loss loss :
+       {RefineOptions::Loss::kHuber, RefineOptions::Loss::kCauchy, RefineOptions::Loss::kTukey}) {
+    RefineOptions::Loss parsed = RefineOptions::Loss::kHuber;
+    EXPECT_TRUE(ParseLoss(LossName(loss), &parsed));
+    EXPECT_EQ(parsed, loss);
+  }
+  RefineOptions::Loss parsed = RefineOptions::Loss::kCauchy;
+  EXPECT_FALSE(ParseLoss("l2", &parsed));
+  EXPECT_EQ(parsed, RefineOptions::Loss::kCauchy);
+}
+
 // The shared settings reach every stage: the calibrator scores and refines with its one
 // horizontal-edge weight and its one δ bound, whatever the sub-structs held.
 TEST(OnlineCalibrator, SharedSettingsReachScoreSearchAndRefine) {

@@ -40,6 +40,9 @@ Status OnlineCalibratorOptions::Validate() const {
   if (!(polish_forward_std_m >= 0)) {
     return Status::Error("online: polish_forward_std_m must be >= 0");
   }
+  if (!(acquired_loss_scale_px > 0)) {
+    return Status::Error("online: acquired_loss_scale_px must be > 0");
+  }
   if (!(refined_score_tolerance >= 0 && refined_score_tolerance < 1)) {
     return Status::Error("online: refined_score_tolerance must be in [0, 1)");
   }
@@ -288,7 +291,7 @@ FrameReport OnlineCalibrator::Polish() {
   }
   const auto start = std::chrono::steady_clock::now();
   // Rotation, δ and the translation along the direction of travel (see the header).
-  RefineOptions refine_options = RefineOptionsInUse();
+  RefineOptions refine_options = RefineOptionsInUse(/*polish=*/true);
   refine_options.translation = RefineOptions::Translation::kAlongTravel;
   refine_options.place_at_time_offset = true;
   report.refine = Refine(frames, state_, state_, anchor_, refine_options);

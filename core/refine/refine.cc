@@ -7,6 +7,8 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <string>
+#include <utility>
 
 #include "core/refine/along_direction_manifold.h"
 #include "cost_functions/calibration_prior_cost.h"
@@ -14,6 +16,31 @@
 #include "cost_functions/memoized_cost.h"
 
 namespace stcalib {
+
+namespace {
+constexpr std::pair<RefineOptions::Loss, const char*> kLossNames[] = {
+    {RefineOptions::Loss::kHuber, "huber"},
+    {RefineOptions::Loss::kCauchy, "cauchy"},
+    {RefineOptions::Loss::kTukey, "tukey"},
+};
+}  // namespace
+
+const char* LossName(RefineOptions::Loss loss) {
+  for (const auto& [value, text] : kLossNames) {
+    if (value == loss) return text;
+  }
+  return "unknown";
+}
+
+bool ParseLoss(const std::string& name, RefineOptions::Loss* loss) {
+  for (const auto& [value, text] : kLossNames) {
+    if (name == text) {
+      *loss = value;
+      return true;
+    }
+  }
+  return false;
+}
 
 const std::array<const char*, kNumAxes> kAxisNames = {
     "roll_deg", "pitch_deg", "yaw_deg", "x_m", "y_m", "z_m", "time_offset_s"};
@@ -80,10 +107,18 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
   }
   problem.AddParameterBlock(&delta, 1);
   // The loss is applied per point inside EdgeAlignmentCost (one residual block per frame).
-  const std::unique_ptr<ceres::LossFunction> loss(
-      options.loss == RefineOptions::Loss::kCauchy
-          ? static_cast<ceres::LossFunction*>(new ceres::CauchyLoss(options.loss_scale_px))
-          : new ceres::HuberLoss(options.loss_scale_px));
+  std::unique_ptr<ceres::LossFunction> loss;
+  switch (options.loss) {
+    case RefineOptions::Loss::kCauchy:
+      loss = std::make_unique<ceres::CauchyLoss>(options.loss_scale_px);
+      break;
+    case RefineOptions::Loss::kHuber:
+      loss = std::make_unique<ceres::HuberLoss>(options.loss_scale_px);
+      break;
+    case RefineOptions::Loss::kTukey:
+      loss = std::make_unique<ceres::TukeyLoss>(options.loss_scale_px);
+      break;
+  }
   for (const CalibrationFrame* frame : window) {
     if (frame->distance_px[0].empty() || frame->distance_px[1].empty() || frame->size() == 0)
       continue;

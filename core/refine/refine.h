@@ -17,7 +17,7 @@ namespace stcalib {
 // ceres::Covariance then gives per-axis standard deviations; an axis is observable when its std
 // is under a threshold.
 struct RefineOptions {
-  enum class Loss { kHuber, kCauchy };
+  enum class Loss { kHuber, kCauchy, kTukey };
   Loss loss = Loss::kCauchy;
   double loss_scale_px = 1.0;      ///< robust-loss scale [px]
   double horizontal_weight = 0.5;  ///< w of method.md §6
@@ -58,6 +58,11 @@ struct RefineOptions {
 
   Status Validate() const;
 };
+
+// RefineOptions::Loss by name: huber | cauchy | tukey. ParseLoss: false, `loss` untouched, when
+// `name` is none of them.
+const char* LossName(RefineOptions::Loss loss);
+bool ParseLoss(const std::string& name, RefineOptions::Loss* loss);
 
 // Axes in result order: roll, pitch, yaw (about the LiDAR axes) [deg], x, y, z (translation of
 // T_camera_lidar) [m], time offset [s].
