@@ -532,7 +532,7 @@ std::string CalibrateFlagsError() {
   for (const auto& [name, value] :
        {std::pair{"--loss", &FLAGS_loss}, std::pair{"--acquired_loss", &FLAGS_acquired_loss}}) {
     RefineOptions::Loss loss;
-    if (!ParseLoss(*value, &loss)) return std::string(name) + " must be huber, cauchy or tukey";
+    if (!ParseLoss(*value, &loss)) return std::string(name) + " must be " + LossChoices();
   }
   OnlineCalibratorOptions::Folds folds;
   if (!ParseFolds(FLAGS_lidar_folds, &folds)) {

@@ -55,7 +55,7 @@ DEFINE_int32(window_frames, kOnline.window_frames,
 DEFINE_double(time_offset_bound_s, kOnline.time_offset_bound_s, "calibrate: |δ| bound [s]");
 DEFINE_bool(estimate_time_offset, kOnline.refine.estimate_time_offset,
             "calibrate: estimate δ (false: keep δ0)");
-DEFINE_string(loss, LossName(kOnline.refine.loss),
+DEFINE_string(loss, LossName(kOnline.refine.loss).c_str(),
               "calibrate: robust loss while acquiring, huber | cauchy | tukey");
 // Refinement from drive 0013's calibration over frames 0-29: 0.27 deg at 1 px, 0.35 at 3 px.
 DEFINE_double(loss_scale_px, kOnline.refine.loss_scale_px, "calibrate: robust-loss scale [px]");
@@ -104,7 +104,7 @@ DEFINE_double(observable_translation_m, kOnline.refine.observable_translation_m,
               "refine: a translation axis is observable below this std [m]");
 DEFINE_double(observable_time_s, kOnline.refine.observable_time_s,
               "refine: δ is observable below this std [s]");
-DEFINE_string(acquired_loss, LossName(kOnline.acquired_loss),
+DEFINE_string(acquired_loss, LossName(kOnline.acquired_loss).c_str(),
               "calibrate: robust loss once acquired (tracking and polish), huber | cauchy | tukey");
 DEFINE_double(acquired_loss_scale_px, kOnline.acquired_loss_scale_px,
               "calibrate: scale of --acquired_loss [px]");
@@ -153,7 +153,7 @@ DEFINE_bool(acquire_time_offset, kOnline.acquire_time_offset,
 DEFINE_bool(bandpass_score, kSource.bandpass_score,
             "calibrate: with --suppress_texture, score on the band-pass IDT (not clipped at 0)");
 DEFINE_string(
-    lidar_folds, stcalib::FoldsName(kOnline.folds),
+    lidar_folds, stcalib::FoldsName(kOnline.folds).c_str(),
     "calibrate: LiDAR horizontal edges below the sensor whose beam above returns at their "
     "own height (a top's front corner seen from above, or its outline against a "
     "background at that height): keep | drop | drop_when_tracking (the default: dropped "

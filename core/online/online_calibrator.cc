@@ -11,6 +11,8 @@
 #include <optional>
 #include <utility>
 
+#include "core/types/enum_names.h"
+
 namespace stcalib {
 namespace {
 
@@ -60,38 +62,19 @@ Status OnlineCalibratorOptions::Validate() const {
 }
 
 namespace {
-constexpr std::pair<OnlineCalibratorOptions::Folds, const char*> kFoldsNames[] = {
-    {OnlineCalibratorOptions::Folds::kKeep, "keep"},
-    {OnlineCalibratorOptions::Folds::kDrop, "drop"},
-    {OnlineCalibratorOptions::Folds::kDropWhenTracking, "drop_when_tracking"}};
+constexpr EnumNames<OnlineCalibratorOptions::Folds, 3> kFoldsNames = {
+    {{OnlineCalibratorOptions::Folds::kKeep, "keep"},
+     {OnlineCalibratorOptions::Folds::kDrop, "drop"},
+     {OnlineCalibratorOptions::Folds::kDropWhenTracking, "drop_when_tracking"}}};
 }  // namespace
 
-const char* FoldsName(OnlineCalibratorOptions::Folds folds) {
-  for (const auto& [value, name] : kFoldsNames) {
-    if (value == folds) return name;
-  }
-  LOG(FATAL) << "unknown OnlineCalibratorOptions::Folds " << static_cast<int>(folds);
-  return "";
-}
+std::string FoldsName(OnlineCalibratorOptions::Folds folds) { return EnumName(kFoldsNames, folds); }
 
 bool ParseFolds(const std::string& name, OnlineCalibratorOptions::Folds* folds) {
-  for (const auto& [value, text] : kFoldsNames) {
-    if (name == text) {
-      *folds = value;
-      return true;
-    }
-  }
-  return false;
+  return ParseEnumName(kFoldsNames, name, folds);
 }
 
-std::string FoldsChoices() {
-  std::string text;
-  const size_t n = std::size(kFoldsNames);
-  for (size_t k = 0; k < n; ++k) {
-    text += (k == 0 ? "" : k + 1 == n ? " or " : ", ") + std::string(kFoldsNames[k].second);
-  }
-  return text;
-}
+std::string FoldsChoices() { return EnumNameChoices(kFoldsNames); }
 
 OnlineCalibratorOptions WithSharedSettings(const OnlineCalibratorOptions& options) {
   OnlineCalibratorOptions out = options;

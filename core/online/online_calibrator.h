@@ -176,7 +176,7 @@ struct OnlineCalibratorOptions {
 };
 
 // OnlineCalibratorOptions::Folds by name: keep | drop | drop_when_tracking.
-const char* FoldsName(OnlineCalibratorOptions::Folds folds);
+std::string FoldsName(OnlineCalibratorOptions::Folds folds);
 // False, `folds` untouched, when `name` is none of them.
 bool ParseFolds(const std::string& name, OnlineCalibratorOptions::Folds* folds);
 // The names, for a message: "keep, drop or drop_when_tracking".

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <memory>
 #include <string>
-#include <utility>
 
 #include "core/refine/along_direction_manifold.h"
+#include "core/types/enum_names.h"
 #include "cost_functions/calibration_prior_cost.h"
 #include "cost_functions/edge_alignment_cost.h"
 #include "cost_functions/memoized_cost.h"
@@ -18,29 +18,18 @@
 namespace stcalib {
 
 namespace {
-constexpr std::pair<RefineOptions::Loss, const char*> kLossNames[] = {
-    {RefineOptions::Loss::kHuber, "huber"},
-    {RefineOptions::Loss::kCauchy, "cauchy"},
-    {RefineOptions::Loss::kTukey, "tukey"},
-};
+constexpr EnumNames<RefineOptions::Loss, 3> kLossNames = {{{RefineOptions::Loss::kHuber, "huber"},
+                                                           {RefineOptions::Loss::kCauchy, "cauchy"},
+                                                           {RefineOptions::Loss::kTukey, "tukey"}}};
 }  // namespace
 
-const char* LossName(RefineOptions::Loss loss) {
-  for (const auto& [value, text] : kLossNames) {
-    if (value == loss) return text;
-  }
-  return "unknown";
-}
+std::string LossName(RefineOptions::Loss loss) { return EnumName(kLossNames, loss); }
 
 bool ParseLoss(const std::string& name, RefineOptions::Loss* loss) {
-  for (const auto& [value, text] : kLossNames) {
-    if (name == text) {
-      *loss = value;
-      return true;
-    }
-  }
-  return false;
+  return ParseEnumName(kLossNames, name, loss);
 }
+
+std::string LossChoices() { return EnumNameChoices(kLossNames); }
 
 const std::array<const char*, kNumAxes> kAxisNames = {
     "roll_deg", "pitch_deg", "yaw_deg", "x_m", "y_m", "z_m", "time_offset_s"};

@@ -60,9 +60,10 @@ struct RefineOptions {
 };
 
 // RefineOptions::Loss by name: huber | cauchy | tukey. ParseLoss: false, `loss` untouched, when
-// `name` is none of them.
-const char* LossName(RefineOptions::Loss loss);
+// `name` is none of them. LossChoices: the names, for a message ("huber, cauchy or tukey").
+std::string LossName(RefineOptions::Loss loss);
 bool ParseLoss(const std::string& name, RefineOptions::Loss* loss);
+std::string LossChoices();
 
 // Axes in result order: roll, pitch, yaw (about the LiDAR axes) [deg], x, y, z (translation of
 // T_camera_lidar) [m], time offset [s].

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/sim/enum_names.h"
+#include "core/types/enum_names.h"
 
 namespace stcalib::sim {
 namespace {

@@ -10,7 +10,7 @@
 #include "core/io/image.h"
 #include "core/io/text.h"
 #include "core/io/velodyne.h"
-#include "core/sim/enum_names.h"
+#include "core/types/enum_names.h"
 
 namespace stcalib::sim {
 namespace {

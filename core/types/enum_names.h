@@ -5,9 +5,9 @@
 #include <string>
 #include <utility>
 
-namespace stcalib::sim {
+namespace stcalib {
 
-// A table of an enum's values and their flag names (`--scene=urban`, `--camera=hd720`).
+// A table of an enum's values and their flag names (`--scene=urban`, `--loss=tukey`).
 template <typename Enum, size_t N>
 using EnumNames = std::array<std::pair<Enum, const char*>, N>;
 
@@ -42,4 +42,4 @@ std::string EnumNameChoices(const EnumNames<Enum, N>& names) {
   return text;
 }
 
-}  // namespace stcalib::sim
+}  // namespace stcalib
