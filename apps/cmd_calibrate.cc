@@ -341,10 +341,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const FrameReport& final_report = outcome->polish.accepted ? outcome->polish : *final_report_ptr;
   const int skipped = verdict.skipped_frames;
   const std::vector<std::string>& unobservable = verdict.unobservable_axes;
-  // The covariance is the refinement the verdict read, except δ's: there the tracking
-  // refinement's std is conditional on the forward translation's prior, so δ is reported from the
-  // polish's solve with both free, and observable only when that solve separated the two and the
-  // polished estimate was kept (verdict.time_offset_observable).
+  // The covariance is the refinement the verdict read, except along the direction of travel
+  // (ReportUncertainty): there δ and the forward translation are reported from the polish's solve
+  // with both free.
   const RefineResult& refine = verdict.refine;
   const TimeForwardPair& pair = verdict.time_forward;
 
@@ -362,20 +361,15 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     fs::remove(out + "/" + kTimeOffsetFileName, ec);
   }
   nlohmann::json std_json, observable_json;
+  const ReportedUncertainty reported = ReportUncertainty(verdict, outcome->time_offset_estimated,
+                                                         job.online.refine.observable_translation_m);
   for (int k = 0; k < kNumAxes; ++k) {
     std_json[kAxisNames[k]] =
-        refine.covariance_ok ? nlohmann::json(refine.std_dev[k]) : nlohmann::json(nullptr);
-    observable_json[kAxisNames[k]] = refine.observable[k];
+        reported.has_std[k] ? nlohmann::json(reported.std_dev[k]) : nlohmann::json(nullptr);
+    observable_json[kAxisNames[k]] = reported.observable[k];
   }
-  // δ's std is the one with the forward translation free; without that solve there is none to
-  // give (the tracking std, conditional on the forward prior, is reported beside it).
   constexpr int kTime = kNumAxes - 1;
   const bool time_estimated = outcome->time_offset_estimated;
-  if (time_estimated) {
-    std_json[kAxisNames[kTime]] =
-        pair.measured ? nlohmann::json(pair.time_offset_std_s) : nlohmann::json(nullptr);
-  }
-  observable_json[kAxisNames[kTime]] = verdict.time_offset_observable;
   auto measured_or_null = [&](double value) {
     return pair.measured ? nlohmann::json(value) : nlohmann::json(nullptr);
   };

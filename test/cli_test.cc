@@ -630,6 +630,11 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
   EXPECT_EQ(result["std"]["time_offset_s"], pair["time_offset_std_s"]);
   EXPECT_GT(pair["time_offset_std_s"].get<double>(),
             5 * pair["time_offset_std_given_forward_prior_s"].get<double>());
+  // So does the forward translation (the camera's z): its std is the solve's with both free
+  // (measured 6.9 cm), not the tracking refinement's 1 mm.
+  EXPECT_FALSE(result["observable"]["z_m"].get<bool>());
+  EXPECT_GE(result["std"]["z_m"].get<double>(), 0.9 * pair["forward_std_m"].get<double>());
+  EXPECT_TRUE(result["observable"]["x_m"].get<bool>());
   EXPECT_THAT(r.output, HasSubstr("time offset: not separated from the forward translation"));
   // The first frames find the calibration's peak, not a side peak 4-6° off (measured 0.71° at
   // the fifth frame from a 3.46° start).
@@ -782,6 +787,10 @@ TEST(Cli, SimulatedDriveMeetsTheAcceptance) {
   EXPECT_TRUE(result["observable"]["time_offset_s"].get<bool>());
   EXPECT_LE(std::abs(result["error"]["time_offset_s"].get<double>()),
             3 * result["std"]["time_offset_s"].get<double>())
+      << r.output;
+  // So is the forward translation, its std the same solve's.
+  EXPECT_TRUE(result["observable"]["z_m"].get<bool>());
+  EXPECT_LE(std::abs(result["error"]["z_m"].get<double>()), 3 * result["std"]["z_m"].get<double>())
       << r.output;
   EXPECT_THAT(r.output, Not(HasSubstr("time offset: not separated")));
   EXPECT_LT(PerFrameNumber(testing::ReadFile(out + "/per_frame.csv"), 4, "rotation_error_deg"),

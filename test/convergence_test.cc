@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 
 #include "core/online/frame_source.h"
@@ -45,6 +46,71 @@ TEST(Convergence, PolishThatDoesNotConvergeRefusesTheClaim) {
   const ConvergenceVerdict kept = VerdictAfterPolish(online, polished);
   EXPECT_FALSE(kept.converged);
   EXPECT_EQ(kept.reason, online.reason);
+}
+
+// The reported std and observability along the direction of travel come from the polish's solve
+// with δ and the forward translation both free, not from the tracking refinement that holds the
+// forward translation with its prior (KITTI: 1 mm there against 4-7 cm with both free).
+TEST(Convergence, ReportedUncertaintyAlongTravelIsThePolishsWithBothFree) {
+  ConvergenceVerdict verdict;
+  RefineResult& refine = verdict.refine;
+  refine.covariance_ok = true;
+  for (int k = 0; k < kNumAxes; ++k) {
+    refine.std_dev[k] = k < 3 ? 0.03 : k < 6 ? 0.001 : 0.0004;
+    refine.observable[k] = true;
+  }
+  TimeForwardPair& pair = verdict.time_forward;
+  pair.measured = true;
+  pair.forward_camera = Eigen::Vector3d(0.0, 0.1, 1.0).normalized();  // camera: z forward
+  pair.forward_std_m = 0.06;
+  pair.time_offset_std_s = 0.006;
+  const double share_y = pair.forward_camera.y() * pair.forward_camera.y();
+  const double share_z = pair.forward_camera.z() * pair.forward_camera.z();
+
+  // Not separated: δ and z rest on the forward translation's prior.
+  ReportedUncertainty held = ReportUncertainty(verdict, true, 0.04);
+  EXPECT_NEAR(held.std_dev[5], std::sqrt(1e-6 + share_z * 0.06 * 0.06), 1e-12);
+  EXPECT_GT(held.std_dev[5], 0.059);
+  EXPECT_FALSE(held.observable[5]);
+  EXPECT_NEAR(held.std_dev[4], std::sqrt(1e-6 + share_y * 0.06 * 0.06), 1e-12);
+  EXPECT_TRUE(held.observable[4]);  // 6 mm: across the direction of travel
+  EXPECT_DOUBLE_EQ(held.std_dev[3], 0.001);
+  EXPECT_TRUE(held.observable[3]);
+  EXPECT_DOUBLE_EQ(held.std_dev[6], 0.006);
+  EXPECT_FALSE(held.observable[6]);  // verdict.time_offset_observable
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_DOUBLE_EQ(held.std_dev[k], 0.03);
+    EXPECT_TRUE(held.observable[k]);
+  }
+  for (int k = 0; k < kNumAxes; ++k) EXPECT_TRUE(held.has_std[k]) << k;
+
+  // Separated, with a forward std under the threshold: z observable, at that std.
+  pair.separated = true;
+  pair.forward_std_m = 0.02;
+  verdict.time_offset_observable = true;
+  const ReportedUncertainty separated = ReportUncertainty(verdict, true, 0.04);
+  EXPECT_NEAR(separated.std_dev[5], std::sqrt(1e-6 + share_z * 0.02 * 0.02), 1e-12);
+  EXPECT_TRUE(separated.observable[5]);
+  EXPECT_TRUE(separated.observable[6]);
+  // Separated but wider than the threshold: not observable either.
+  pair.forward_std_m = 0.05;
+  EXPECT_FALSE(ReportUncertainty(verdict, true, 0.04).observable[5]);
+
+  // No polish measured the pair: no std along travel to give, and nothing observable there.
+  pair = TimeForwardPair();
+  verdict.time_offset_observable = false;
+  refine.forward_camera = Eigen::Vector3d::UnitZ();
+  const ReportedUncertainty unmeasured = ReportUncertainty(verdict, true, 0.04);
+  EXPECT_FALSE(unmeasured.has_std[5]);
+  EXPECT_FALSE(unmeasured.observable[5]);
+  EXPECT_FALSE(unmeasured.has_std[6]);
+  EXPECT_TRUE(unmeasured.has_std[4]);
+  EXPECT_DOUBLE_EQ(unmeasured.std_dev[4], 0.001);
+
+  // δ not estimated: the refinement's own numbers throughout.
+  const ReportedUncertainty fixed_time = ReportUncertainty(verdict, false, 0.04);
+  EXPECT_DOUBLE_EQ(fixed_time.std_dev[5], 0.001);
+  EXPECT_TRUE(fixed_time.observable[5]);
 }
 
 TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {

@@ -173,6 +173,45 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   return verdict;
 }
 
+ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool time_offset_estimated,
+                                      double observable_translation_m) {
+  const RefineResult& refine = verdict.refine;
+  const TimeForwardPair& pair = verdict.time_forward;
+  ReportedUncertainty reported;
+  for (int k = 0; k < kNumAxes; ++k) {
+    reported.has_std[k] = refine.covariance_ok;
+    reported.std_dev[k] = refine.std_dev[k];
+    reported.observable[k] = refine.observable[k];
+  }
+  if (!time_offset_estimated) return reported;
+  constexpr int kTime = kNumAxes - 1;
+  reported.has_std[kTime] = pair.measured;
+  reported.std_dev[kTime] = pair.measured ? pair.time_offset_std_s : 0.0;
+  reported.observable[kTime] = verdict.time_offset_observable;
+  const Eigen::Vector3d forward =
+      pair.measured ? pair.forward_camera.normalized() : refine.forward_camera.normalized();
+  for (int i = 0; i < 3; ++i) {
+    const int k = 3 + i;
+    const double share = forward[i] * forward[i];
+    const bool along_travel = share > 0.5;
+    if (!pair.measured) {
+      if (along_travel) {
+        reported.has_std[k] = false;
+        reported.std_dev[k] = 0;
+        reported.observable[k] = false;
+      }
+      continue;
+    }
+    if (!refine.covariance_ok) continue;
+    const double std_m = std::sqrt(refine.std_dev[k] * refine.std_dev[k] +
+                                   share * pair.forward_std_m * pair.forward_std_m);
+    reported.std_dev[k] = std_m;
+    reported.observable[k] = refine.observable[k] && std_m < observable_translation_m &&
+                             (pair.separated || !along_travel);
+  }
+  return reported;
+}
+
 ConvergenceVerdict VerdictAfterPolish(const ConvergenceVerdict& online,
                                       const ConvergenceVerdict& polished) {
   if (polished.converged) return polished;

@@ -69,6 +69,24 @@ struct ConvergenceVerdict {
   bool time_offset_observable = false;
 };
 
+// The per-axis standard deviations and observability a run reports (result.json's `std` and
+// `observable`): the verdict's refinement's, except along the direction of travel. That
+// refinement holds the forward translation with its prior, so there its std and δ's are
+// conditional on that prior (on the shared KITTI frames 1 mm and 0.4 ms, where the polish's solve
+// with both free gives 4.2 cm and 3.8 ms). With δ estimated and the polish's pair measured, δ's
+// std is the polish's and each translation axis gets the polish's forward variance along its
+// share of the direction of travel; δ, and a translation axis mostly along travel (over half of
+// the direction's square on it), are observable only when the polish separated the pair (then
+// they moved with the window's data; otherwise they rest on the forward translation's prior).
+// Without the pair measured, δ has no std and neither has such an axis: neither is observable.
+struct ReportedUncertainty {
+  std::array<bool, kNumAxes> has_std{};  ///< false: none to report (null in result.json)
+  std::array<double, kNumAxes> std_dev{};
+  std::array<bool, kNumAxes> observable{};
+};
+ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool time_offset_estimated,
+                                      double observable_translation_m);
+
 // `reports` are all of the run's frame reports in order; `initial` the run's start.
 ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                                     const std::vector<FrameReport>& reports,

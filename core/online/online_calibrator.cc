@@ -298,6 +298,7 @@ FrameReport OnlineCalibrator::Polish() {
     report.time_forward.time_offset_std_s = pair.std_dev[6];
     report.time_forward.forward_std_m = pair.forward_std_m;
     report.time_forward.correlation = pair.time_forward_correlation;
+    report.time_forward.forward_camera = pair.forward_camera;
   }
   if (!report.refine.usable) {
     report.reason = "polish: refinement failed (" + report.refine.message + ")";

@@ -193,6 +193,8 @@ struct TimeForwardPair {
   double time_offset_std_s = 0;  ///< δ's std with the forward translation free [s]
   double forward_std_m = 0;      ///< the forward translation's std [m]
   double correlation = 0;        ///< of δ with the forward translation
+  // The direction of travel that translation is along (unit, camera frame).
+  Eigen::Vector3d forward_camera = Eigen::Vector3d::UnitZ();
 };
 
 struct FrameReport {

@@ -73,6 +73,7 @@ RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
   const Eigen::Vector3d forward =
       moving ? Eigen::Vector3d(start.T_camera_lidar.linear() * last_twist.linear_m_s.normalized())
              : Eigen::Vector3d::UnitZ();
+  result.forward_camera = forward;
   using Translation = RefineOptions::Translation;
   ceres::Problem problem;
   switch (options.translation) {

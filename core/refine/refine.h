@@ -86,6 +86,9 @@ struct RefineResult {
   // standard deviation of that translation [m].
   double time_forward_correlation = 0;
   double forward_std_m = 1e9;
+  // That direction (unit, camera frame): the window's last LiDAR velocity, or the camera axis
+  // when the window is not moving.
+  Eigen::Vector3d forward_camera = Eigen::Vector3d::UnitZ();
 };
 
 // `rotation_prior` holds the rotation (the search result), `mount_prior` the translation and
