@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numeric>
 
+#include "core/features/fast_atan2.h"
+
 namespace stcalib {
 
 ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points) {
@@ -13,7 +15,8 @@ ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points) {
   rings.azimuth_rad.resize(n);
   rings.range_m.resize(n);
   for (int i = 0; i < n; ++i) {
-    rings.azimuth_rad[i] = static_cast<float>(std::atan2(points[i].y(), points[i].x()));
+    // FastAtan2 is within 2e-11 rad of std::atan2, far below the float the azimuth is kept in.
+    rings.azimuth_rad[i] = static_cast<float>(FastAtan2(points[i].y(), points[i].x()));
     rings.range_m[i] = static_cast<float>(points[i].norm());
   }
   rings.ring_begin.push_back(0);
