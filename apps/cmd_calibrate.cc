@@ -18,6 +18,7 @@
 #include "core/io/image.h"
 #include "core/io/kitti_calib.h"
 #include "core/io/text.h"
+#include "core/features/image_features.h"
 #include "core/online/convergence.h"
 #include "core/search/adaptive_grid_search.h"
 
@@ -147,6 +148,10 @@ CalibrateJob CalibrateJobFromFlags() {
   job.source.suppress_texture = FLAGS_suppress_texture;
   job.source.bandpass_score = FLAGS_bandpass_score;
   job.source.oriented_maps = FLAGS_oriented_maps;
+  // CalibrateFlagsError has checked the name.
+  CHECK(ParseDetector(FLAGS_detector, &job.source.image.detector)) << FLAGS_detector;
+  job.source.image.min_segment_length_px = FLAGS_min_segment_px;
+  job.source.image.max_edge_density = FLAGS_max_edge_density;
   job.convergence.check_suppressed_health = FLAGS_check_suppressed_health;
   job.convergence.health_check.min_health = FLAGS_min_health;
   job.convergence.min_final_health = FLAGS_lost_health;  // lost is never converged
@@ -531,6 +536,10 @@ std::string CalibrateFlagsError() {
   OnlineCalibratorOptions::Folds folds;
   if (!ParseFolds(FLAGS_lidar_folds, &folds)) {
     return "--lidar_folds must be " + FoldsChoices();
+  }
+  ImageFeatureOptions::Detector detector;
+  if (!ParseDetector(FLAGS_detector, &detector)) {
+    return "--detector must be " + DetectorChoices() + ", got '" + FLAGS_detector + "'";
   }
   return "";
 }

@@ -51,12 +51,8 @@ int RunFeatures() {
   status = drive.LoadImage(frame, &image);
   if (!status.ok()) return ReportError("features", status);
   ImageFeatureOptions image_options;
-  if (FLAGS_detector == "lsd") {
-    image_options.detector = ImageFeatureOptions::Detector::kLsd;
-  } else if (FLAGS_detector == "fld") {
-    image_options.detector = ImageFeatureOptions::Detector::kFastLine;
-  } else if (FLAGS_detector != "canny") {
-    return UsageError("features", "--detector must be canny, lsd or fld");
+  if (!ParseDetector(FLAGS_detector, &image_options.detector)) {
+    return UsageError("features", "--detector must be " + DetectorChoices());
   }
   image_options.min_segment_length_px = FLAGS_min_segment_px;
   image_options.max_edge_density = FLAGS_max_edge_density;

@@ -9,6 +9,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/ximgproc/fast_line_detector.hpp>
 
+#include "core/types/enum_names.h"
+
 namespace stcalib {
 namespace {
 
@@ -68,6 +70,23 @@ size_t UnsplitPyramidLevels(const ImageFeatureOptions& options) {
 }
 
 }  // namespace
+
+namespace {
+constexpr EnumNames<ImageFeatureOptions::Detector, 3> kDetectorNames = {
+    {{ImageFeatureOptions::Detector::kCanny, "canny"},
+     {ImageFeatureOptions::Detector::kLsd, "lsd"},
+     {ImageFeatureOptions::Detector::kFastLine, "fld"}}};
+}  // namespace
+
+std::string DetectorName(ImageFeatureOptions::Detector detector) {
+  return EnumName(kDetectorNames, detector);
+}
+
+bool ParseDetector(const std::string& name, ImageFeatureOptions::Detector* detector) {
+  return ParseEnumName(kDetectorNames, name, detector);
+}
+
+std::string DetectorChoices() { return EnumNameChoices(kDetectorNames); }
 
 Status ImageFeatureOptions::Validate() const {
   if (!(basin_px > 0)) return Status::Error("image features: basin_px must be > 0");

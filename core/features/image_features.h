@@ -49,6 +49,12 @@ struct ImageFeatureOptions {
   Status Validate() const;
 };
 
+// ImageFeatureOptions::Detector by name: canny | lsd | fld. ParseDetector: false, `detector`
+// untouched, when `name` is none of them. DetectorChoices: the names, for a message.
+std::string DetectorName(ImageFeatureOptions::Detector detector);
+bool ParseDetector(const std::string& name, ImageFeatureOptions::Detector* detector);
+std::string DetectorChoices();
+
 // The maps of one edge orientation (near-vertical or near-horizontal image edges).
 struct OrientedMaps {
   cv::Mat idt;                   ///< CV_32F, smoothed IDT in [0, 255]
