@@ -148,10 +148,8 @@ CalibrateJob CalibrateJobFromFlags() {
   job.source.suppress_texture = FLAGS_suppress_texture;
   job.source.bandpass_score = FLAGS_bandpass_score;
   job.source.oriented_maps = FLAGS_oriented_maps;
-  // CalibrateFlagsError has checked the name.
-  CHECK(ParseDetector(FLAGS_detector, &job.source.image.detector)) << FLAGS_detector;
-  job.source.image.min_segment_length_px = FLAGS_min_segment_px;
-  job.source.image.max_edge_density = FLAGS_max_edge_density;
+  // CalibrateFlagsError has checked the detector's name.
+  CHECK(ImageOptionsFromFlags(&job.source.image).ok()) << FLAGS_detector;
   job.convergence.check_suppressed_health = FLAGS_check_suppressed_health;
   job.convergence.health_check.min_health = FLAGS_min_health;
   job.convergence.min_final_health = FLAGS_lost_health;  // lost is never converged
@@ -167,7 +165,8 @@ std::string TimeOffsetPriorNote(const CalibrateOutcome& outcome) {
   if (TimeOffsetRestsOn(outcome) != "forward_translation_prior") return "";
   const TimeForwardPair& pair = outcome.time_forward;
   const std::string consequence =
-      "so it rests on that translation's prior (time offset error = forward error / speed)";
+      "so it rests on that translation's prior, as does the translation along travel (time "
+      "offset error = forward error / speed)";
   if (!pair.measured) {
     return "time offset: estimated with the forward translation held (the polish, which frees "
            "both, did not measure them), " +
@@ -537,10 +536,9 @@ std::string CalibrateFlagsError() {
   if (!ParseFolds(FLAGS_lidar_folds, &folds)) {
     return "--lidar_folds must be " + FoldsChoices();
   }
-  ImageFeatureOptions::Detector detector;
-  if (!ParseDetector(FLAGS_detector, &detector)) {
-    return "--detector must be " + DetectorChoices() + ", got '" + FLAGS_detector + "'";
-  }
+  ImageFeatureOptions image;
+  const Status image_status = ImageOptionsFromFlags(&image);
+  if (!image_status.ok()) return image_status.message();
   return "";
 }
 

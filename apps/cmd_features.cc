@@ -51,11 +51,8 @@ int RunFeatures() {
   status = drive.LoadImage(frame, &image);
   if (!status.ok()) return ReportError("features", status);
   ImageFeatureOptions image_options;
-  if (!ParseDetector(FLAGS_detector, &image_options.detector)) {
-    return UsageError("features", "--detector must be " + DetectorChoices());
-  }
-  image_options.min_segment_length_px = FLAGS_min_segment_px;
-  image_options.max_edge_density = FLAGS_max_edge_density;
+  const Status flags_status = ImageOptionsFromFlags(&image_options);
+  if (!flags_status.ok()) return UsageError("features", flags_status.message());
   image_options.split_orientation = true;
   image_options.precise_distance = true;
   const ImageFeatures image_features = ExtractImageFeatures(image, image_options);

@@ -3,6 +3,7 @@
 #include <random>
 #include <string>
 
+#include "core/features/image_features.h"
 #include "core/io/drive.h"
 #include "core/types/calibration.h"
 #include "core/types/status.h"
@@ -38,5 +39,9 @@ Status StartingCalibration(const Drive& drive, const std::string& init_calib,
                            Rigid3d* T_camera_lidar);
 // Opens --drive with --calib_dir.
 Status OpenDriveFromFlags(Drive* drive);
+// --detector, --min_segment_px and --max_edge_density into `options` (features, calibrate, demo
+// and check read the same image edges); an error naming the flag for an unknown detector, with
+// `options` untouched.
+Status ImageOptionsFromFlags(ImageFeatureOptions* options);
 
 }  // namespace stcalib::cli

@@ -58,4 +58,16 @@ Status StartingCalibration(const Drive& drive, const std::string& init_calib,
 
 Status OpenDriveFromFlags(Drive* drive) { return OpenDrive(FLAGS_drive, FLAGS_calib_dir, drive); }
 
+Status ImageOptionsFromFlags(ImageFeatureOptions* options) {
+  ImageFeatureOptions::Detector detector;
+  if (!ParseDetector(FLAGS_detector, &detector)) {
+    return Status::Error("--detector must be " + DetectorChoices() + ", got '" + FLAGS_detector +
+                         "'");
+  }
+  options->detector = detector;
+  options->min_segment_length_px = FLAGS_min_segment_px;
+  options->max_edge_density = FLAGS_max_edge_density;
+  return Status::Ok();
+}
+
 }  // namespace stcalib::cli

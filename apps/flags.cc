@@ -30,14 +30,14 @@ DEFINE_double(oxts_error_scale, 1.0,
               "simulate: multiplies every σ of the oxts error, drift and white noise alike "
               "(after --oxts_white_position_m); 0 = exact navigation, 2-3 = a poorer GPS/INS");
 DEFINE_string(detector, stcalib::DetectorName(stcalib::ImageFeatureOptions().detector).c_str(),
-              "features, calibrate: image edges: canny | lsd | fld (cv::ximgproc "
-              "FastLineDetector)");
+              "features, calibrate, demo, check: image edges: canny | lsd | fld "
+              "(cv::ximgproc FastLineDetector)");
 DEFINE_double(min_segment_px, stcalib::ImageFeatureOptions().min_segment_length_px,
-              "features, calibrate: lsd/fld segments shorter than this are dropped as texture "
-              "[px]");
+              "features, calibrate, demo, check: lsd/fld segments shorter than this are dropped "
+              "as texture [px]");
 DEFINE_double(max_edge_density, stcalib::ImageFeatureOptions().max_edge_density,
-              "features, calibrate: drop edge pixels in windows denser than this share (texture), "
-              "0 = off");
+              "features, calibrate, demo, check: drop edge pixels in windows denser than this "
+              "share (texture, any detector), 0 = off");
 // calibrate
 DEFINE_string(init_calib, "", "calibrate: initial calib_velo_to_cam.txt (default: the drive's)");
 DEFINE_double(perturb_rot_deg, 0.0,

@@ -197,6 +197,8 @@ TEST(Cli, CalibrateFromAStartSoWrongNothingProjects) {
   EXPECT_FALSE(result["time_offset_vs_forward"]["measured"].get<bool>());
   EXPECT_TRUE(result["std"]["time_offset_s"].is_null()) << result["std"];
   EXPECT_FALSE(result["observable"]["time_offset_s"].get<bool>());
+  EXPECT_TRUE(result["std"]["z_m"].is_null()) << result["std"];  // the forward translation too
+  EXPECT_FALSE(result["observable"]["z_m"].get<bool>());
   EXPECT_THAT(r.output, HasSubstr("the polish, which frees both, did not measure them"));
 }
 

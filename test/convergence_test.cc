@@ -73,7 +73,7 @@ TEST(Convergence, ReportedUncertaintyAlongTravelIsThePolishsWithBothFree) {
   EXPECT_GT(held.std_dev[5], 0.059);
   EXPECT_FALSE(held.observable[5]);
   EXPECT_NEAR(held.std_dev[4], std::sqrt(1e-6 + share_y * 0.06 * 0.06), 1e-12);
-  EXPECT_TRUE(held.observable[4]);  // 6 mm: across the direction of travel
+  EXPECT_TRUE(held.observable[4]);  // across the direction of travel: the verdict's
   EXPECT_DOUBLE_EQ(held.std_dev[3], 0.001);
   EXPECT_TRUE(held.observable[3]);
   EXPECT_DOUBLE_EQ(held.std_dev[6], 0.006);
@@ -95,6 +95,14 @@ TEST(Convergence, ReportedUncertaintyAlongTravelIsThePolishsWithBothFree) {
   // Separated but wider than the threshold: not observable either.
   pair.forward_std_m = 0.05;
   EXPECT_FALSE(ReportUncertainty(verdict, true, 0.04).observable[5]);
+  // A diagonal direction of travel (no axis over half of it): the axis it lies most along.
+  pair.forward_camera = Eigen::Vector3d(0.6, 0.0, 0.8);
+  pair.forward_std_m = 0.06;
+  pair.separated = false;
+  const ReportedUncertainty diagonal = ReportUncertainty(verdict, true, 0.04);
+  EXPECT_FALSE(diagonal.observable[5]);
+  EXPECT_TRUE(diagonal.observable[3]);  // x: the verdict's, its std grown by 0.36 of the forward
+  EXPECT_NEAR(diagonal.std_dev[3], std::sqrt(1e-6 + 0.36 * 0.06 * 0.06), 1e-12);
 
   // No polish measured the pair: no std along travel to give, and nothing observable there.
   pair = TimeForwardPair();

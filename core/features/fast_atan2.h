@@ -9,7 +9,7 @@ namespace stcalib {
 // and infinities give meaningless angles: callers pass finite points), branch-light and
 // inlined: several times cheaper than libm's correctly rounded atan2, for the dynamic filter's
 // range image, which bins two angles per point into 0.25° cells (a cell changes only for a point
-// within 2e-11 rad of a border).
+// within 2e-11 rad of a border), and for ring splitting, which keeps azimuths as float.
 //
 // The octant reduction leaves t = min/max of |x|, |y| in [0, 1]; above tan(π/8), atan t =
 // π/4 + atan((t − 1)/(t + 1)), so the series runs on |u| ≤ tan(π/8) = 0.4142, where its terms

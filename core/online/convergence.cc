@@ -190,10 +190,12 @@ ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool ti
   reported.observable[kTime] = verdict.time_offset_observable;
   const Eigen::Vector3d forward =
       pair.measured ? pair.forward_camera.normalized() : refine.forward_camera.normalized();
+  int along = 0;  // the translation axis the direction of travel lies most along
+  forward.cwiseAbs().maxCoeff(&along);
   for (int i = 0; i < 3; ++i) {
     const int k = 3 + i;
     const double share = forward[i] * forward[i];
-    const bool along_travel = share > 0.5;
+    const bool along_travel = i == along;
     if (!pair.measured) {
       if (along_travel) {
         reported.has_std[k] = false;
@@ -206,8 +208,12 @@ ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool ti
     const double std_m = std::sqrt(refine.std_dev[k] * refine.std_dev[k] +
                                    share * pair.forward_std_m * pair.forward_std_m);
     reported.std_dev[k] = std_m;
-    reported.observable[k] = refine.observable[k] && std_m < observable_translation_m &&
-                             (pair.separated || !along_travel);
+    // Across the direction of travel the verdict's observability stands (the verdict held the
+    // axis at its start when it was not); along it, the pair's.
+    if (along_travel) {
+      reported.observable[k] =
+          refine.observable[k] && pair.separated && std_m < observable_translation_m;
+    }
   }
   return reported;
 }

@@ -48,6 +48,8 @@ struct ConvergenceVerdict {
   bool converged = false;
   std::string reason;         ///< "converged" or "not converged: …"
   CalibrationState estimate;  ///< the final estimate, unobservable axes back at the start
+  // The axes held at their start because the last refinement could not pin them down (not the
+  // forward translation and δ resting on the forward prior: see ReportUncertainty).
   std::vector<std::string> unobservable_axes;
   TimeOffsetProfile time_offset_profile;  ///< aliasing guard over δ (method.md §7)
   std::array<RotationAxisProfile, 3> rotation_profiles;
@@ -72,13 +74,16 @@ struct ConvergenceVerdict {
 // The per-axis standard deviations and observability a run reports (result.json's `std` and
 // `observable`): the verdict's refinement's, except along the direction of travel. That
 // refinement holds the forward translation with its prior, so there its std and δ's are
-// conditional on that prior (on the shared KITTI frames 1 mm and 0.4 ms, where the polish's solve
-// with both free gives 4.2 cm and 3.8 ms). With δ estimated and the polish's pair measured, δ's
-// std is the polish's and each translation axis gets the polish's forward variance along its
-// share of the direction of travel; δ, and a translation axis mostly along travel (over half of
-// the direction's square on it), are observable only when the polish separated the pair (then
-// they moved with the window's data; otherwise they rest on the forward translation's prior).
-// Without the pair measured, δ has no std and neither has such an axis: neither is observable.
+// conditional on that prior (on the shared KITTI frames from 2°, seed 2: 1 mm and 0.5 ms, where
+// the polish's solve with both free gives 6.9 cm and 6.1 ms). With δ estimated and the polish's
+// pair measured, δ's std is the polish's and each translation axis gets the polish's forward
+// variance along its share of the direction of travel. δ, and the translation axis the direction
+// of travel lies most along, are observable only when the polish separated the pair (they then
+// moved with the window's data; otherwise they rest on the forward translation's prior, and are
+// not held at their start: they are not in ConvergenceVerdict::unobservable_axes). The other
+// axes keep the verdict's observability. Without the pair measured, δ has no std and neither has
+// the axis along travel: neither is observable. With δ not estimated the refinement's numbers
+// stand throughout (the polish then measures no pair).
 struct ReportedUncertainty {
   std::array<bool, kNumAxes> has_std{};  ///< false: none to report (null in result.json)
   std::array<double, kNumAxes> std_dev{};
