@@ -18,7 +18,6 @@
 #include "core/io/image.h"
 #include "core/io/kitti_calib.h"
 #include "core/io/text.h"
-#include "core/features/image_features.h"
 #include "core/online/convergence.h"
 #include "core/search/adaptive_grid_search.h"
 
