@@ -285,6 +285,49 @@ TEST(DynamicFilter, RemovesAMoverWithNoReferencePointNearby) {
   }
 }
 
+// The older reference is compared with its view (ReferenceSweep::check_visibility): a mover
+// stands where that sweep saw through to a far wall, and is removed; a wall that a nearer
+// object hid from that sweep has no neighbour either, but was never seen, and is kept. The
+// hidden wall straddles the azimuth seam behind the sensor (±180°), where the range image's
+// columns wrap.
+TEST(DynamicFilter, OlderReferenceRemovesMoversWhereItSawThroughAndKeepsWhatItDidNotSee) {
+  auto grid = [](const Eigen::Vector3d& corner, const Eigen::Vector3d& du,
+                 const Eigen::Vector3d& dv, int n) {
+    std::vector<Eigen::Vector3d> points;
+    for (int a = 0; a < n; ++a) {
+      for (int b = 0; b < n; ++b) points.push_back(corner + a * du + b * dv);
+    }
+    return points;
+  };
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), y = Eigen::Vector3d::UnitY(),
+                        z = Eigen::Vector3d::UnitZ();
+  // Current sweep: a car ahead-left, a wall 20 m behind (y from −0.2 to +0.25 m).
+  const std::vector<Eigen::Vector3d> car = grid({15, 5, -0.5}, 0.15 * y, 0.15 * z, 8);
+  const std::vector<Eigen::Vector3d> hidden = grid({-20, -0.2, -0.2}, 0.15 * y, 0.15 * z, 4);
+  std::vector<Eigen::Vector3d> current = car;
+  current.insert(current.end(), hidden.begin(), hidden.end());
+  // Older sweep: a far wall behind the car's place, and an occluder 8 m behind the sensor.
+  std::vector<Eigen::Vector3d> older = grid({32, 6, -2}, 0.12 * y - 0.04 * x, 0.12 * z, 40);
+  const std::vector<Eigen::Vector3d> occluder = grid({-8, -0.6, -0.6}, 0.03 * y, 0.03 * z, 41);
+  older.insert(older.end(), occluder.begin(), occluder.end());
+  ReferenceSweep reference;
+  reference.points = &older;
+  reference.check_visibility = true;
+  const DynamicFilterResult result =
+      DetectDynamicPoints(current, {}, {reference}, DynamicFilterOptions());
+  for (size_t i = 0; i < current.size(); ++i) {
+    EXPECT_EQ(result.dynamic[i], i < car.size() ? 1 : 0) << "point " << i;
+  }
+  // Both lack a neighbour within τ: only the view tells them apart.
+  EXPECT_EQ(result.dynamic_clusters, 1);
+  // Without the visibility check the hidden wall goes too.
+  reference.check_visibility = false;
+  const DynamicFilterResult blind =
+      DetectDynamicPoints(current, {}, {reference}, DynamicFilterOptions());
+  EXPECT_EQ(blind.dynamic_clusters, 2);
+  EXPECT_EQ(blind.removed_points, static_cast<int>(current.size()));
+}
+
 // A drive's LiDAR stamps are δ before the true capture times (method.md §2), so a local map
 // merged with the poses at the stamps puts an earlier sweep where the vehicle's motion between
 // the stamps, not between the captures, says. While it accelerates or turns the two differ by

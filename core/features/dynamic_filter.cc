@@ -103,23 +103,46 @@ int Find(std::vector<int>& parent, int i) {
   return i;
 }
 
-// Spherical range image of a sweep: the nearest return per (azimuth, elevation) cell.
+// Spherical range image of a sweep: the nearest return per (azimuth, elevation) cell. Only the
+// azimuth columns marked in `columns` are filled (RangeAround reads a query's column and the two
+// beside it, see MarkAround): a reference point's elevation is computed only when its column is
+// wanted, and the cells read hold what a full image would.
 class RangeImage {
  public:
-  RangeImage(const std::vector<Eigen::Vector3d>& points, double max_range_m)
+  class Columns {
+   public:
+    Columns() : wanted_(kAz, 0) {}
+    // Wants the columns RangeAround(p) reads.
+    void MarkAround(const Eigen::Vector3d& p) {
+      const int a = Column(p);
+      for (int da = -1; da <= 1; ++da) wanted_[(a + da + kAz) % kAz] = 1;
+    }
+    bool Wanted(int column) const { return wanted_[column] != 0; }
+
+   private:
+    std::vector<uint8_t> wanted_;
+  };
+
+  RangeImage(const std::vector<Eigen::Vector3d>& points, double max_range_m,
+             const Columns& columns)
       : range_(kAz * kEl, kEmpty) {
     const double max_r2 = max_range_m * max_range_m;
     for (const auto& p : points) {
-      if (p.squaredNorm() > max_r2) continue;
-      const int c = Cell(p);
-      if (c >= 0) range_[c] = std::min(range_[c], static_cast<float>(p.norm()));
+      const double r2 = p.squaredNorm();
+      if (r2 > max_r2) continue;
+      const int a = Column(p);
+      if (!columns.Wanted(a)) continue;
+      const int e = Row(p);
+      if (e < 0) continue;
+      float& cell = range_[e * kAz + a];
+      cell = std::min(cell, static_cast<float>(std::sqrt(r2)));
     }
   }
   // Nearest previous range in the 3×3 cells around the direction of p; +inf when nothing.
   float RangeAround(const Eigen::Vector3d& p) const {
-    const int c = Cell(p);
-    if (c < 0) return kEmpty;
-    const int a = c % kAz, e = c / kAz;
+    const int e = Row(p);
+    if (e < 0) return kEmpty;
+    const int a = Column(p);
     float best = kEmpty;
     for (int de = -1; de <= 1; ++de) {
       if (e + de < 0 || e + de >= kEl) continue;
@@ -133,13 +156,15 @@ class RangeImage {
  private:
   static constexpr int kAz = 1440, kEl = 160;  // 0.25° cells, elevation −30°..+10°
   static constexpr float kEmpty = std::numeric_limits<float>::infinity();
-  static int Cell(const Eigen::Vector3d& p) {
+  static int Column(const Eigen::Vector3d& p) {
     const double az = FastAtan2(p.y(), p.x());
+    return std::min(static_cast<int>((az + M_PI) / (2 * M_PI) * kAz), kAz - 1);
+  }
+  // Elevation row, or −1 outside −30°..+10°.
+  static int Row(const Eigen::Vector3d& p) {
     const double el = FastAtan2(p.z(), p.head<2>().norm());
-    const int a = static_cast<int>((az + M_PI) / (2 * M_PI) * kAz);
     const int e = static_cast<int>((el * 180 / M_PI + 30.0) / 0.25);
-    if (e < 0 || e >= kEl) return -1;
-    return e * kAz + std::min(a, kAz - 1);
+    return e >= 0 && e < kEl ? e : -1;
   }
   std::vector<float> range_;
 };
@@ -250,9 +275,12 @@ void FlagAgainst(const std::vector<Eigen::Vector3d>& current, const std::vector<
   // No reference point within reach: every query's nearest neighbour is beyond τ.
   std::unique_ptr<PointKdTree> tree;
   if (!moved.empty()) tree = std::make_unique<PointKdTree>(moved);
-  std::unique_ptr<RangeImage> view;  // built when the first flagged point needs it
   const Rigid3d T_reference_current = reference.T_current_reference.inverse();
   std::vector<int8_t> verdict(selected.size(), -1);  // per representative: 0 static, 1 flagged
+  // Points beyond τ, in the reference's frame when their place must be seen to have been free.
+  std::vector<int> beyond;
+  std::vector<Eigen::Vector3d> beyond_in_reference;
+  RangeImage::Columns columns;
   for (size_t k = 0; k < selected.size(); ++k) {
     if ((*flagged)[k] || !queried[k]) continue;
     const int rep = representative[k];
@@ -265,15 +293,22 @@ void FlagAgainst(const std::vector<Eigen::Vector3d>& current, const std::vector<
       if (distance > Tau(options, p.norm())) verdict[rep] = 1;
     }
     if (verdict[rep] == 0) continue;
-    const Eigen::Vector3d& p = current[selected[k]];
-    if (reference.check_visibility) {
-      if (view == nullptr) view = std::make_unique<RangeImage>(own, options.max_range_m + 5.0);
-      // Seen from the reference viewpoint, was this place free space (a longer return)?
-      const Eigen::Vector3d q = T_reference_current * p;
-      const double r = q.norm();
-      if (view->RangeAround(q) < r + options.visibility_margin_m + 0.02 * r) continue;
+    if (!reference.check_visibility) {
+      (*flagged)[k] = 1;
+      continue;
     }
-    (*flagged)[k] = 1;
+    beyond.push_back(static_cast<int>(k));
+    beyond_in_reference.push_back(T_reference_current * current[selected[k]]);
+    columns.MarkAround(beyond_in_reference.back());
+  }
+  if (beyond.empty()) return;
+  // Seen from the reference viewpoint, was this place free space (a longer return)?
+  const RangeImage view(own, options.max_range_m + 5.0, columns);
+  for (size_t b = 0; b < beyond.size(); ++b) {
+    const Eigen::Vector3d& q = beyond_in_reference[b];
+    const double r = q.norm();
+    if (view.RangeAround(q) < r + options.visibility_margin_m + 0.02 * r) continue;
+    (*flagged)[beyond[b]] = 1;
   }
 }
 
@@ -362,12 +397,13 @@ DynamicFilterResult DetectDynamicPoints(const std::vector<Eigen::Vector3d>& curr
 
   // Points sharing a query voxel share one nearest-neighbour query.
   std::vector<int> representative(selected.size());
-  {
+  if (!(options.query_voxel_m > 0)) {
+    std::iota(representative.begin(), representative.end(), 0);  // every point its own query
+  } else {
     VoxelIndex first(selected.size());
     for (size_t k = 0; k < selected.size(); ++k) {
-      const double query_cell = options.query_voxel_m > 0 ? options.query_voxel_m : 1e-6;
       representative[k] =
-          first.Emplace(VoxelKey(current[selected[k]], query_cell), static_cast<int>(k));
+          first.Emplace(VoxelKey(current[selected[k]], options.query_voxel_m), static_cast<int>(k));
     }
   }
   // Where the queries can find a neighbour within τ: cells at least τ_max wide, dilated by one.
