@@ -123,8 +123,7 @@ class RangeImage {
     std::vector<uint8_t> wanted_;
   };
 
-  RangeImage(const std::vector<Eigen::Vector3d>& points, double max_range_m,
-             const Columns& columns)
+  RangeImage(const std::vector<Eigen::Vector3d>& points, double max_range_m, const Columns& columns)
       : range_(kAz * kEl, kEmpty) {
     const double max_r2 = max_range_m * max_range_m;
     for (const auto& p : points) {
