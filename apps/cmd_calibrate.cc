@@ -135,6 +135,7 @@ CalibrateJob CalibrateJobFromFlags() {
   o.refine_frames = FLAGS_refine_frames;
   o.refine_map_sweeps = FLAGS_refine_map_sweeps;
   o.tracking_gain = FLAGS_tracking_gain;
+  o.tracking_max_lag_deg = FLAGS_tracking_max_lag_deg;
   o.refined_score_tolerance = FLAGS_refined_score_tolerance;
   o.tracking_update_every = FLAGS_tracking_update_every;
   o.refine.observable_rotation_deg = FLAGS_observable_rotation_deg;
@@ -364,8 +365,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     fs::remove(out + "/" + kTimeOffsetFileName, ec);
   }
   nlohmann::json std_json, observable_json;
-  const ReportedUncertainty reported = ReportUncertainty(verdict, outcome->time_offset_estimated,
-                                                         job.online.refine.observable_translation_m);
+  const ReportedUncertainty reported = ReportUncertainty(
+      verdict, outcome->time_offset_estimated, job.online.refine.observable_translation_m);
   for (int k = 0; k < kNumAxes; ++k) {
     std_json[kAxisNames[k]] =
         reported.has_std[k] ? nlohmann::json(reported.std_dev[k]) : nlohmann::json(nullptr);

@@ -99,6 +99,9 @@ DEFINE_int32(max_points_per_frame, kOnline.refine.max_points_per_frame,
              "refine: LiDAR edge points used per frame");
 DEFINE_double(tracking_gain, kOnline.tracking_gain,
               "calibrate: share of an accepted update taken while tracking");
+DEFINE_double(tracking_max_lag_deg, kOnline.tracking_max_lag_deg,
+              "calibrate: while tracking, the rotation moves at least to within this of an "
+              "accepted update's estimate (0 = tracking_gain only) [deg]");
 DEFINE_double(refined_score_tolerance, kOnline.refined_score_tolerance,
               "calibrate: the refined rotation is taken when it scores within this share of "
               "the best candidate (0 = the best score wins)");

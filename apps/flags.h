@@ -48,6 +48,7 @@ DECLARE_int32(refine_map_sweeps);
 DECLARE_int32(max_points_per_frame);
 DECLARE_int32(refine_max_iterations);
 DECLARE_double(tracking_gain);
+DECLARE_double(tracking_max_lag_deg);
 DECLARE_double(refined_score_tolerance);
 DECLARE_int32(tracking_update_every);
 DECLARE_double(observable_rotation_deg);

@@ -172,6 +172,26 @@ TEST(OnlineCalibrator, FoldsInTheWindowFollowTheOption) {
 
 // The refinement's loss: refine.loss while acquiring, acquired_loss once acquired (with no
 // rotation grid there is no acquisition); the names parse both ways.
+// A tracking update takes tracking_gain of a small move (scatter) and all but
+// tracking_max_lag_deg of a large one (a correction); the two agree where they meet, so the
+// step grows continuously with the move.
+TEST(OnlineCalibrator, TrackingRotationShareLagsALargeMoveByTheMaxLagOnly) {
+  const double g = 0.3, lag = 0.3 * M_PI / 180.0;
+  for (double move_deg : {0.0, 0.1, 0.3, 0.4}) {  // (1 − g)·move ≤ lag: the gain
+    EXPECT_DOUBLE_EQ(TrackingRotationShare(g, move_deg * M_PI / 180.0, lag), g) << move_deg;
+  }
+  for (double move_deg : {0.5, 1.0, 3.0}) {  // the estimate ends exactly `lag` short
+    const double move = move_deg * M_PI / 180.0;
+    const double share = TrackingRotationShare(g, move, lag);
+    EXPECT_GT(share, g) << move_deg;
+    EXPECT_NEAR((1.0 - share) * move, lag, 1e-15) << move_deg;
+  }
+  const double meet = lag / (1.0 - g);  // 0.4286°: both rules give g
+  EXPECT_NEAR(TrackingRotationShare(g, meet * (1 + 1e-9), lag), g, 1e-8);
+  EXPECT_DOUBLE_EQ(TrackingRotationShare(g, 1.0, 0.0), g);      // no limit
+  EXPECT_DOUBLE_EQ(TrackingRotationShare(1.0, 1.0, lag), 1.0);  // full steps stay full
+}
+
 TEST(OnlineCalibrator, AcquiredLossOnceAcquired) {
   OnlineCalibratorOptions options;
   options.refine.loss = RefineOptions::Loss::kCauchy;

@@ -49,6 +49,9 @@ Status OnlineCalibratorOptions::Validate() const {
     return Status::Error("online: refined_score_tolerance must be in [0, 1)");
   }
   if (refine_map_sweeps < 0) return Status::Error("online: refine_map_sweeps must be >= 0");
+  if (!(tracking_max_lag_deg >= 0)) {
+    return Status::Error("online: tracking_max_lag_deg must be >= 0");
+  }
   if (tracking_update_every < 1) {
     return Status::Error("online: tracking_update_every must be >= 1");
   }
@@ -59,6 +62,13 @@ Status OnlineCalibratorOptions::Validate() const {
   }
   STCALIB_RETURN_IF_ERROR(search.Validate());
   return refine.Validate();
+}
+
+double TrackingRotationShare(double gain, double rotation_rad, double max_lag_rad) {
+  if (max_lag_rad > 0 && (1.0 - gain) * rotation_rad > max_lag_rad) {
+    return 1.0 - max_lag_rad / rotation_rad;
+  }
+  return gain;
 }
 
 namespace {
@@ -497,12 +507,15 @@ void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowSc
              options_.tracking_gain < 1.0) {
     const CalibrationState& c = report->after;
     const double g = options_.tracking_gain;
-    const double g_rotation = report->coarse_search ? 1.0 : g;
-    report->after = Step(
-        state_,
-        g_rotation * LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear()),
-        g * (c.T_camera_lidar.translation() - state_.T_camera_lidar.translation()),
-        g * (c.time_offset_s - state_.time_offset_s));
+    const Eigen::Vector3d rotation =
+        LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear());
+    const double g_rotation =
+        report->coarse_search ? 1.0
+                              : TrackingRotationShare(g, rotation.norm(),
+                                                      options_.tracking_max_lag_deg * M_PI / 180.0);
+    report->after = Step(state_, g_rotation * rotation,
+                         g * (c.T_camera_lidar.translation() - state_.T_camera_lidar.translation()),
+                         g * (c.time_offset_s - state_.time_offset_s));
   }
 }
 
