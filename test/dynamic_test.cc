@@ -469,6 +469,45 @@ TEST(SweepCache, HoldsAWideLocalMapAndStaysBoundedOnABackwardPass) {
               backward.capacity());
 }
 
+// A finished sweep takes its base's fields over instead of copying them: once finished, Base
+// serves the finished entry (the same fields, bit for bit, as a fresh cache's base), the cache
+// holds one entry for the sweep, and later sweeps' dynamic filters still read it.
+TEST(SweepCache, AFinishedSweepIsItsOwnBase) {
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  DriveMotion motion;
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive, &motion));
+  SweepCache cache(drive, motion, LidarFeatureOptions());
+  const LidarFrameFeatures *finished = nullptr, *base = nullptr;
+  ASSERT_TRUE(cache.Finished(5, &finished).ok());
+  const size_t cached = cache.cached_sweeps();
+  ASSERT_TRUE(cache.Base(5, &base).ok());
+  EXPECT_EQ(base, finished);
+  EXPECT_EQ(cache.cached_sweeps(), cached);  // Base loaded nothing again
+  ASSERT_GT(base->edges.size(), 0u);
+
+  SweepCache fresh(drive, motion, LidarFeatureOptions());
+  const LidarFrameFeatures* fresh_base = nullptr;
+  ASSERT_TRUE(fresh.Base(5, &fresh_base).ok());
+  EXPECT_TRUE(fresh_base->edges.points_lidar.empty());  // a base alone has no edges
+  ASSERT_EQ(base->scan.size(), fresh_base->scan.size());
+  ASSERT_GT(base->scan.size(), 0u);
+  EXPECT_EQ(base->scan.points_lidar, fresh_base->scan.points_lidar);
+  EXPECT_EQ(base->deskewed, fresh_base->deskewed);
+  EXPECT_EQ(base->ground, fresh_base->ground);
+  EXPECT_EQ(base->point_time_s, fresh_base->point_time_s);
+  EXPECT_EQ(base->rings.range_m, fresh_base->rings.range_m);
+
+  // Frame 6's filter reads frame 5 (finished) as its reference: the same result as from a cache
+  // that finished nothing before.
+  const LidarFrameFeatures *next = nullptr, *fresh_next = nullptr;
+  ASSERT_TRUE(cache.Finished(6, &next).ok());
+  SweepCache other(drive, motion, LidarFeatureOptions());
+  ASSERT_TRUE(other.Finished(6, &fresh_next).ok());
+  EXPECT_EQ(next->dynamic.dynamic, fresh_next->dynamic.dynamic);
+  EXPECT_EQ(next->edges.points_lidar, fresh_next->edges.points_lidar);
+}
+
 // The dynamic filter's range image bins FastAtan2's angles: within 2e-11 rad of std::atan2 over
 // every octant, at the octant borders and the reduction's switch (tan π/8), and within 1e-15 rad
 // with the same sign on the axes and signed zeros.

@@ -114,6 +114,10 @@ void SweepCache::EvictNewerThan(size_t last) {
 }
 
 Status SweepCache::Base(size_t frame, const LidarFrameFeatures** features) {
+  if (auto done = finished_.find(frame); done != finished_.end()) {  // holds the base's fields
+    *features = &done->second;
+    return Status::Ok();
+  }
   auto it = base_.find(frame);
   if (it == base_.end()) {
     STCALIB_RETURN_IF_ERROR(drive_.CheckFrame(frame));
@@ -164,7 +168,11 @@ Status SweepCache::Finished(size_t frame, const LidarFrameFeatures** features) {
     STCALIB_RETURN_IF_ERROR(References(frame, &references));
     const LidarFrameFeatures* base;
     STCALIB_RETURN_IF_ERROR(Base(frame, &base));
-    LidarFrameFeatures f = *base;
+    // The finished sweep takes the base's fields over (finishing only adds the dynamic marks and
+    // the edges) and Base serves them from then on: the sweep (~9 MB) is not copied.
+    auto node = base_.extract(frame);
+    CHECK(!node.empty() && &node.mapped() == base) << "sweep " << frame << " not in the cache";
+    LidarFrameFeatures f = std::move(node.mapped());
     FinishLidarFrameFeatures(references, options_, &f);
     it = finished_.emplace(frame, std::move(f)).first;
     Evict(frame);

@@ -85,7 +85,9 @@ class SweepCache {
  public:
   SweepCache(const Drive& drive, const DriveMotion& motion, const LidarFeatureOptions& options,
              size_t capacity = 8);
-  Status Base(size_t frame, const LidarFrameFeatures** features);      ///< no dynamic filter
+  // The sweep's base fields (scan to ground); the dynamic marks and edges are set only when the
+  // sweep is already finished, whose entry then serves them (one copy of each sweep).
+  Status Base(size_t frame, const LidarFrameFeatures** features);
   Status Finished(size_t frame, const LidarFrameFeatures** features);  ///< with it, and edges
   // The previous sweep and the one DynamicFilterOptions::long_baseline_s back.
   Status References(size_t frame, std::vector<ReferenceFeatures>* references);
