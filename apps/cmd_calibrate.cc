@@ -152,6 +152,7 @@ CalibrateJob CalibrateJobFromFlags() {
   CHECK(ImageOptionsFromFlags(&job.source.image).ok()) << FLAGS_detector;
   job.convergence.check_suppressed_health = FLAGS_check_suppressed_health;
   job.convergence.health_check.min_health = FLAGS_min_health;
+  job.convergence.max_translation_move_sigmas = FLAGS_max_translation_move_sigmas;
   job.convergence.min_final_health = FLAGS_lost_health;  // lost is never converged
   return job;
 }
@@ -183,6 +184,7 @@ std::string TimeOffsetPriorNote(const CalibrateOutcome& outcome) {
 int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const char* kCommand = "calibrate";
   Status status = job.online.Validate();
+  if (status.ok()) status = job.convergence.Validate();
   if (!status.ok()) return UsageError(kCommand, status.message());
   Drive drive;
   status = OpenDrive(job.drive_dir, job.calib_dir, &drive);

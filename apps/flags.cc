@@ -124,6 +124,9 @@ DEFINE_double(polish_forward_std_m, kOnline.polish_forward_std_m,
               "forward std [m]");
 DEFINE_double(min_health, kConvergence.health_check.min_health,
               "check, calibrate: the calibration holds when the mean health reaches this");
+DEFINE_double(max_translation_move_sigmas, kConvergence.max_translation_move_sigmas,
+              "calibrate: converged only when the translation ends within this many "
+              "--prior_sigma_translation_m of the start on each axis (0 = no limit)");
 DEFINE_bool(check_suppressed_health, kConvergence.check_suppressed_health,
             "calibrate: converged also needs the health check on texture-suppressed maps of the "
             "last 9 frames to hold");

@@ -60,6 +60,7 @@ DECLARE_bool(acquired_loss_when_tracking);
 DECLARE_double(observable_time_s);
 DECLARE_double(min_health);
 DECLARE_bool(check_suppressed_health);
+DECLARE_double(max_translation_move_sigmas);
 DECLARE_int32(local_map_sweeps);
 DECLARE_bool(remove_dynamic);
 DECLARE_bool(use_ndt);

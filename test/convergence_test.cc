@@ -121,6 +121,51 @@ TEST(Convergence, ReportedUncertaintyAlongTravelIsThePolishsWithBothFree) {
   EXPECT_TRUE(fixed_time.observable[5]);
 }
 
+// The translation may end at most max_sigmas of its prior's sigma from the start on each axis:
+// the axis furthest beyond that limit is named with its signed move; within it, or with the
+// limit off, none is. Options with a negative or NaN limit are refused.
+TEST(Convergence, TranslationMovedBeyondItsPriorIsNamed) {
+  CalibrationState start;
+  start.T_camera_lidar.translation() = Eigen::Vector3d(-0.004, -0.076, -0.272);
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  // The KITTI wrong-δ run's move: 12.4 cm on x, 1.6 cm on y, against 2 x 5 cm.
+  const CalibrationState sideways = Step(start, zero, Eigen::Vector3d(-0.124, 0.016, 0.001), 0);
+  TranslationMove moved = TranslationMoveBeyondPrior(start, sideways, 2.0, 0.05);
+  EXPECT_EQ(moved.axis, 0);
+  EXPECT_NEAR(moved.move_m, -0.124, 1e-12);
+  // Two axes beyond the limit: the larger move is named.
+  const CalibrationState two = Step(start, zero, Eigen::Vector3d(0.11, 0.0, -0.13), 0);
+  moved = TranslationMoveBeyondPrior(start, two, 2.0, 0.05);
+  EXPECT_EQ(moved.axis, 2);
+  EXPECT_NEAR(moved.move_m, -0.13, 1e-12);
+  // The largest good simulated run's move (7.8 cm on y) is within the limit; so is 9.9 cm.
+  EXPECT_EQ(TranslationMoveBeyondPrior(start, Step(start, zero, Eigen::Vector3d(0, 0.078, 0), 0),
+                                       2.0, 0.05)
+                .axis,
+            -1);
+  EXPECT_EQ(TranslationMoveBeyondPrior(start, Step(start, zero, Eigen::Vector3d(0.099, 0, 0), 0),
+                                       2.0, 0.05)
+                .axis,
+            -1);
+  // A wider prior, or the limit off, accepts the sideways move; rotation and δ do not count.
+  EXPECT_EQ(TranslationMoveBeyondPrior(start, sideways, 2.0, 0.1).axis, -1);
+  EXPECT_EQ(TranslationMoveBeyondPrior(start, sideways, 0.0, 0.05).axis, -1);
+  const CalibrationState turned = Step(start, Eigen::Vector3d(0.05, -0.05, 0.05), zero, 0.1);
+  EXPECT_EQ(TranslationMoveBeyondPrior(start, turned, 2.0, 0.05).axis, -1);
+
+  ConvergenceOptions options;
+  EXPECT_TRUE(options.Validate().ok());
+  options.max_translation_move_sigmas = -1;
+  EXPECT_FALSE(options.Validate().ok());
+  EXPECT_NE(options.Validate().message().find("max_translation_move_sigmas"), std::string::npos);
+  options.max_translation_move_sigmas = std::nan("");
+  EXPECT_FALSE(options.Validate().ok());
+  options.max_translation_move_sigmas = 0;
+  EXPECT_TRUE(options.Validate().ok());
+  options.min_final_health = 1.5;
+  EXPECT_FALSE(options.Validate().ok());
+}
+
 TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;

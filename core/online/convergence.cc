@@ -8,6 +8,34 @@
 
 namespace stcalib {
 
+Status ConvergenceOptions::Validate() const {
+  if (!(max_translation_move_sigmas >= 0)) {
+    return Status::Error("convergence: max_translation_move_sigmas must be >= 0 (0 = no limit)");
+  }
+  if (!(min_final_health >= 0 && min_final_health <= 1)) {
+    return Status::Error("convergence: min_final_health (--lost_health) must be in [0, 1]");
+  }
+  return health_check.Validate();
+}
+
+TranslationMove TranslationMoveBeyondPrior(const CalibrationState& initial,
+                                           const CalibrationState& estimate, double max_sigmas,
+                                           double prior_sigma_m) {
+  TranslationMove moved;
+  if (!(max_sigmas > 0)) return moved;
+  const Eigen::Vector3d move =
+      estimate.T_camera_lidar.translation() - initial.T_camera_lidar.translation();
+  double largest_m = max_sigmas * prior_sigma_m;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(move[i]) > largest_m) {
+      largest_m = std::abs(move[i]);
+      moved.axis = i;
+      moved.move_m = move[i];
+    }
+  }
+  return moved;
+}
+
 ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                                     const std::vector<FrameReport>& reports,
                                     const CalibrationState& initial,
@@ -106,6 +134,10 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
     profile_problem = text;
   }
 
+  const TranslationMove moved =
+      TranslationMoveBeyondPrior(initial, verdict.estimate, options.max_translation_move_sigmas,
+                                 online.refine.prior_sigma_translation_m);
+
   char text[256];
   if (used.empty()) {
     verdict.reason = "not converged: all " + std::to_string(verdict.skipped_frames) +
@@ -142,6 +174,17 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                      " (held at their start values; the scene does not constrain them)";
   } else if (!profile_problem.empty()) {
     verdict.reason = "not converged: " + profile_problem;
+  } else if (moved.axis >= 0) {
+    char long_text[512];
+    std::snprintf(long_text, sizeof(long_text),
+                  "not converged: the translation moved %+.1f cm from the start on %s, more than "
+                  "%.1f times its prior's %.1f cm: the data overrules the prior (a wrong time "
+                  "offset can show up as a sideways shift); if the start may be that far off, "
+                  "widen the prior (--prior_sigma_translation_m)",
+                  100 * moved.move_m, kAxisNames[3 + moved.axis],
+                  options.max_translation_move_sigmas,
+                  100 * online.refine.prior_sigma_translation_m);
+    verdict.reason = long_text;
   } else if (last.health < options.min_final_health) {
     std::snprintf(text, sizeof(text),
                   "not converged: health %.3f < %.2f (the estimate is not a clear optimum of the "

@@ -35,6 +35,14 @@ struct ConvergenceOptions {
   // Likewise the score over δ (ProfileTimeOffset over the whole bound at the estimate's
   // extrinsic, 2.5 ms steps) must peak within this of the estimate's δ [s].
   double max_profile_offset_s = 0.01;
+  // The translation may end at most this many of its prior's sigmas
+  // (RefineOptions::prior_sigma_translation_m) from the start on each axis (0 = no limit). The
+  // prior says how far off the start may be; an estimate beyond it is the data overruling the
+  // prior, which a compensating error does as readily as a wrong start (a KITTI start with δ
+  // 50 ms off and no δ scan, under tracking_max_lag_deg 0.3, ended 12.4 cm sideways with a std
+  // of 1.0 cm and δ 22 ms off, every other rule passed). Measured on scripts/sweep's 46 runs
+  // (starts ±5 cm on each axis, prior 5 cm): the largest move on an axis 7.8 cm (1.6 sigma).
+  double max_translation_move_sigmas = 2.0;
   // An independent check of the estimate on the texture-suppressed maps of the last
   // `check_frames` frames (windows of HealthCheckOptions::window_frames): foliage makes a plain
   // map's optimum degrees off look healthy, the suppressed maps do not (measured on KITTI: an
@@ -42,6 +50,8 @@ struct ConvergenceOptions {
   bool check_suppressed_health = true;
   int check_frames = 9;
   HealthCheckOptions health_check;
+
+  Status Validate() const;
 };
 
 struct ConvergenceVerdict {
@@ -91,6 +101,17 @@ struct ReportedUncertainty {
 };
 ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool time_offset_estimated,
                                       double observable_translation_m);
+
+// The translation axis (0-2: camera x, y, z) that moved furthest from `initial` to `estimate`
+// beyond `max_sigmas` × `prior_sigma_m` (ConvergenceOptions::max_translation_move_sigmas), and
+// that move [m]; axis -1 when none did or the limit is off (max_sigmas 0).
+struct TranslationMove {
+  int axis = -1;
+  double move_m = 0;
+};
+TranslationMove TranslationMoveBeyondPrior(const CalibrationState& initial,
+                                           const CalibrationState& estimate, double max_sigmas,
+                                           double prior_sigma_m);
 
 // `reports` are all of the run's frame reports in order; `initial` the run's start.
 ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,

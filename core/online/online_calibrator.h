@@ -119,18 +119,18 @@ struct OnlineCalibratorOptions {
   double tracking_gain = 0.3;
   // ... but the rotation never lags an accepted update's estimate by more than this
   // (TrackingRotationShare): a move beyond a single window's scatter is taken as a correction,
-  // but for this remainder (0 = off, the default: tracking_gain alone) [deg]. With the gain alone
-  // a start that the first search left 1.3° off closes 30 % of the gap per frame (KITTI from
-  // 1.5°, seed 3: 0.87° at the fifth frame; 0.49° at 0.3°). Measured on the shared KITTI frames
-  // (16 starts, 1-3°; fifth frame mean / final mean / within 0.2°): off 0.362° / 0.151° / 15;
-  // 0.2° 0.314 / 0.167 / 13; 0.25° 0.299 / 0.167 / 13; 0.3° 0.305 / 0.148 / 16; 0.4° 0.336 /
-  // 0.158 / 13; 0.5° 0.372 / 0.148 / 14. On simulated drives it rarely acts (3 of scripts/sweep's
-  // 30 changed; a start the first search left 3.5° off, seed 33, went from 1.7° to 0.2° at the
-  // fifth frame; 40-frame drives unchanged). Not the default: at 0.3° a KITTI start with δ 50
-  // ms off and no δ scan (Cli.KittiWrongTimeOffsetIsRefused) ended 0.26° and 12.3 cm off
-  // sideways (camera x, reported std 1.1 cm) with δ 22 ms off, and was claimed, where the gain
-  // alone leaves it refused (its last frames' roll score peaks 0.5° away).
-  double tracking_max_lag_deg = 0.0;
+  // but for this remainder (0 = off: tracking_gain alone) [deg]. With the gain alone a start
+  // that the first search left 1.3° off closes 30 % of the gap per frame (KITTI from 1.5°, seed
+  // 3: 0.87° at the fifth frame; 0.49° at 0.3°). Measured on the shared KITTI frames (16 starts,
+  // 1-3°; fifth frame mean / final mean / within 0.2°): off 0.362° / 0.151° / 15; 0.2° 0.314 /
+  // 0.167 / 13; 0.25° 0.299 / 0.167 / 13; 0.3° 0.305 / 0.148 / 16; 0.4° 0.336 / 0.158 / 13;
+  // 0.5° 0.372 / 0.148 / 14. On simulated drives it rarely acts (3 of scripts/sweep's 30
+  // changed; a start the first search left 3.5° off, seed 33, went from 1.7° to 0.2° at the
+  // fifth frame; 40-frame drives unchanged). At 0.3° a KITTI start with δ 50 ms off and no δ
+  // scan (Cli.KittiWrongTimeOffsetIsRefused) ends 0.26° and 12.3 cm off sideways (camera x,
+  // reported std 1.1 cm) with δ 22 ms off; ConvergenceOptions::max_translation_move_sigmas
+  // refuses it (the gain alone left it refused by its roll profile, peaking 0.5° away).
+  double tracking_max_lag_deg = 0.3;
   // Candidates are judged by their window score (the score map: a wide basin, but its peak can sit
   // a few tenths of a degree from the refinement's optimum). The refined rotation, with the chosen
   // candidate's translation and δ, is taken in place of the best-scoring candidate when it scores
