@@ -665,10 +665,13 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
   EXPECT_GE(result["std"]["z_m"].get<double>(), 0.9 * pair["forward_std_m"].get<double>());
   EXPECT_TRUE(result["observable"]["x_m"].get<bool>());
   EXPECT_THAT(r.output, HasSubstr("time offset: not separated from the forward translation"));
-  // The first frames find the calibration's peak, not a side peak 4-6° off (measured 0.71° at
-  // the fifth frame from a 3.46° start).
+  // The first frames find the calibration's peak, not a side peak 4-6° off: the first search
+  // (frame 2) lands 4.7° off, the next frame's comes back to 1.13°. Measured at the fifth frame
+  // from a 3.46° start: 1.00° (0.71° with --tracking_max_lag_deg=0, whose smaller move at frame 3
+  // dropped the health to 0.84 and so ran a coarse search at frame 4); 0.29° by the seventh.
   const std::string csv = testing::ReadFile(out + "/per_frame.csv");
-  EXPECT_LT(PerFrameNumber(csv, 4, "rotation_error_deg"), 1.0);
+  EXPECT_LT(PerFrameNumber(csv, 4, "rotation_error_deg"), 1.5);
+  EXPECT_LT(PerFrameNumber(csv, 6, "rotation_error_deg"), 0.5);
   // While tracking, the frames between updates neither search nor refine.
   const int updates = ExpectUpdateTimingMatches(result, csv, 30);
   EXPECT_LT(updates, 30);
@@ -678,9 +681,10 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
 // Issue 5's fifth-frame criterion (≤ 0.3°) from ±2° (seeds 1-4): the refinement's rotation is
 // taken in place of the score map's best when it scores within 10 % of it (the map's peak sits a
 // few tenths of a degree from the refinement's optimum on these frames). Measured at the fifth
-// frame: 0.14, 0.71, 0.47 and 0.26° with the default; 0.29, 0.71, 0.47 and 0.50° with the
-// tolerance at 0 (the best score wins, as before). Over 16 starts of 1-3°: 10 of 16 within 0.3°
-// (median 0.26°) against 3 of 16 (median 0.43°), none worse.
+// frame: 0.14, 1.00, 0.21 and 0.14° with the default; 0.38, 1.00, 0.47 and 0.50° with the
+// tolerance at 0 (the best score wins, as before). At tracking_max_lag_deg 0 (before
+// 2026-12-06): 0.14, 0.71, 0.47 and 0.26° against 0.29, 0.71, 0.47 and 0.50°, and over 16
+// starts of 1-3° 10 of 16 within 0.3° (median 0.26°) against 3 of 16 (median 0.43°), none worse.
 TEST(Cli, KittiFifthFrameTakesTheRefinedRotationWithinTheScoreTolerance) {
   STCALIB_REQUIRE_KITTI();
   testing::ScopedTempDir tmp;
