@@ -166,6 +166,56 @@ TEST(Convergence, TranslationMovedBeyondItsPriorIsNamed) {
   EXPECT_FALSE(options.Validate().ok());
 }
 
+// The translation axes across travel report at least the refinements' spread about the
+// estimate, and are not observable once it reaches the threshold; the axis along travel keeps
+// the polish's numbers; without updates the covariance stands.
+TEST(Convergence, ReportedTranslationStdIsAtLeastTheRefinementsSpread) {
+  ConvergenceVerdict verdict;
+  RefineResult& refine = verdict.refine;
+  refine.covariance_ok = true;
+  for (int k = 0; k < kNumAxes; ++k) {
+    refine.std_dev[k] = k < 3 ? 0.03 : k < 6 ? 0.008 : 0.0004;
+    refine.observable[k] = true;
+  }
+  TimeForwardPair& pair = verdict.time_forward;
+  pair.measured = true;
+  pair.separated = true;
+  pair.forward_camera = Eigen::Vector3d::UnitZ();
+  pair.forward_std_m = 0.02;
+  pair.time_offset_std_s = 0.002;
+  verdict.time_offset_observable = true;
+  const ReportedUncertainty plain = ReportUncertainty(verdict, true, 0.04);
+  EXPECT_DOUBLE_EQ(plain.std_dev[3], 0.008);
+  EXPECT_TRUE(plain.observable[4]);
+
+  // KITTI from ±5 cm, seed 2: the windows' optima 4.2 and 5.6 cm about the estimate.
+  verdict.refinement_spread_m = Eigen::Vector3d(0.042, 0.056, 0.003);
+  verdict.refinement_spread_updates = 10;
+  const ReportedUncertainty wide = ReportUncertainty(verdict, true, 0.04);
+  EXPECT_DOUBLE_EQ(wide.std_dev[3], 0.042);
+  EXPECT_DOUBLE_EQ(wide.std_dev[4], 0.056);
+  EXPECT_FALSE(wide.observable[3]);
+  EXPECT_FALSE(wide.observable[4]);
+  EXPECT_NEAR(wide.std_dev[5], std::sqrt(0.008 * 0.008 + 0.02 * 0.02), 1e-12);  // along travel
+  EXPECT_TRUE(wide.observable[5]);
+  // A spread under the covariance's std changes nothing; one under the threshold keeps the axis.
+  verdict.refinement_spread_m = Eigen::Vector3d(0.005, 0.025, 0.0);
+  const ReportedUncertainty narrow = ReportUncertainty(verdict, true, 0.04);
+  EXPECT_DOUBLE_EQ(narrow.std_dev[3], 0.008);
+  EXPECT_DOUBLE_EQ(narrow.std_dev[4], 0.025);
+  EXPECT_TRUE(narrow.observable[4]);
+  // δ not estimated: every translation axis, the one along travel too.
+  verdict.refinement_spread_m = Eigen::Vector3d(0.0, 0.0, 0.05);
+  const ReportedUncertainty fixed_time = ReportUncertainty(verdict, false, 0.04);
+  EXPECT_DOUBLE_EQ(fixed_time.std_dev[5], 0.05);
+  EXPECT_FALSE(fixed_time.observable[5]);
+  EXPECT_TRUE(fixed_time.observable[3]);
+  // No pair measured: the axes across travel still widen.
+  pair = TimeForwardPair();
+  verdict.refinement_spread_m = Eigen::Vector3d(0.06, 0.0, 0.0);
+  EXPECT_FALSE(ReportUncertainty(verdict, true, 0.04).observable[3]);
+}
+
 TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;

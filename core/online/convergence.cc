@@ -12,6 +12,7 @@ Status ConvergenceOptions::Validate() const {
   if (!(max_translation_move_sigmas >= 0)) {
     return Status::Error("convergence: max_translation_move_sigmas must be >= 0 (0 = no limit)");
   }
+  if (spread_updates < 0) return Status::Error("convergence: spread_updates must be >= 0");
   if (!(min_final_health >= 0 && min_final_health <= 1)) {
     return Status::Error("convergence: min_final_health (--lost_health) must be in [0, 1]");
   }
@@ -134,6 +135,19 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
     profile_problem = text;
   }
 
+  for (auto it = updates.rbegin();
+       it != updates.rend() && verdict.refinement_spread_updates < options.spread_updates; ++it) {
+    if (!(*it)->refine.usable) continue;
+    const Eigen::Vector3d d = (*it)->refine.state.T_camera_lidar.translation() -
+                              verdict.estimate.T_camera_lidar.translation();
+    verdict.refinement_spread_m += d.cwiseProduct(d);
+    ++verdict.refinement_spread_updates;
+  }
+  if (verdict.refinement_spread_updates > 0) {
+    verdict.refinement_spread_m =
+        (verdict.refinement_spread_m / verdict.refinement_spread_updates).cwiseSqrt();
+  }
+
   const TranslationMove moved =
       TranslationMoveBeyondPrior(initial, verdict.estimate, options.max_translation_move_sigmas,
                                  online.refine.prior_sigma_translation_m);
@@ -226,7 +240,18 @@ ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool ti
     reported.std_dev[k] = refine.std_dev[k];
     reported.observable[k] = refine.observable[k];
   }
-  if (!time_offset_estimated) return reported;
+  // A translation axis: at least the window refinements' spread about the estimate, and not
+  // observable beyond the threshold.
+  auto widen_to_spread = [&](int i) {
+    const int k = 3 + i;
+    if (!reported.has_std[k] || verdict.refinement_spread_updates == 0) return;
+    reported.std_dev[k] = std::max(reported.std_dev[k], verdict.refinement_spread_m[i]);
+    if (reported.std_dev[k] >= observable_translation_m) reported.observable[k] = false;
+  };
+  if (!time_offset_estimated) {
+    for (int i = 0; i < 3; ++i) widen_to_spread(i);
+    return reported;
+  }
   constexpr int kTime = kNumAxes - 1;
   reported.has_std[kTime] = pair.measured;
   reported.std_dev[kTime] = pair.measured ? pair.time_offset_std_s : 0.0;
@@ -244,6 +269,8 @@ ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool ti
         reported.has_std[k] = false;
         reported.std_dev[k] = 0;
         reported.observable[k] = false;
+      } else {
+        widen_to_spread(i);
       }
       continue;
     }
@@ -252,10 +279,13 @@ ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool ti
                                    share * pair.forward_std_m * pair.forward_std_m);
     reported.std_dev[k] = std_m;
     // Across the direction of travel the verdict's observability stands (the verdict held the
-    // axis at its start when it was not); along it, the pair's.
+    // axis at its start when it was not), widened to the refinements' spread; along it, the
+    // pair's.
     if (along_travel) {
       reported.observable[k] =
           refine.observable[k] && pair.separated && std_m < observable_translation_m;
+    } else {
+      widen_to_spread(i);
     }
   }
   return reported;
