@@ -48,22 +48,36 @@ TEST(Convergence, PolishThatDoesNotConvergeRefusesTheClaim) {
   EXPECT_EQ(kept.reason, online.reason);
 }
 
-// The reported std and observability along the direction of travel come from the polish's solve
-// with δ and the forward translation both free, not from the tracking refinement that holds the
-// forward translation with its prior (KITTI: 1 mm there against 4-7 cm with both free).
-TEST(Convergence, ReportedUncertaintyAlongTravelIsThePolishsWithBothFree) {
+// A verdict whose refinement's covariance gives every rotation axis `rotation_std_rad`, every
+// translation axis `translation_std_m` and δ 0.4 ms, all observable, and whose polish measured
+// the pair (δ, forward translation) along `forward_camera` with these stds.
+ConvergenceVerdict VerdictWithCovariance(double rotation_std_rad, double translation_std_m,
+                                         const Eigen::Vector3d& forward_camera,
+                                         double forward_std_m, double time_offset_std_s) {
   ConvergenceVerdict verdict;
   RefineResult& refine = verdict.refine;
   refine.covariance_ok = true;
   for (int k = 0; k < kNumAxes; ++k) {
-    refine.std_dev[k] = k < 3 ? 0.03 : k < 6 ? 0.001 : 0.0004;
+    refine.std_dev[k] = k < 3 ? rotation_std_rad : k < 6 ? translation_std_m : 0.0004;
     refine.observable[k] = true;
   }
   TimeForwardPair& pair = verdict.time_forward;
   pair.measured = true;
-  pair.forward_camera = Eigen::Vector3d(0.0, 0.1, 1.0).normalized();  // camera: z forward
-  pair.forward_std_m = 0.06;
-  pair.time_offset_std_s = 0.006;
+  pair.forward_camera = forward_camera;
+  pair.forward_std_m = forward_std_m;
+  pair.time_offset_std_s = time_offset_std_s;
+  return verdict;
+}
+
+// The reported std and observability along the direction of travel come from the polish's solve
+// with δ and the forward translation both free, not from the tracking refinement that holds the
+// forward translation with its prior (KITTI: 1 mm there against 4-7 cm with both free).
+TEST(Convergence, ReportedUncertaintyAlongTravelIsThePolishsWithBothFree) {
+  // Camera: z forward.
+  ConvergenceVerdict verdict =
+      VerdictWithCovariance(0.03, 0.001, Eigen::Vector3d(0.0, 0.1, 1.0).normalized(), 0.06, 0.006);
+  RefineResult& refine = verdict.refine;
+  TimeForwardPair& pair = verdict.time_forward;
   const double share_y = pair.forward_camera.y() * pair.forward_camera.y();
   const double share_z = pair.forward_camera.z() * pair.forward_camera.z();
 
@@ -170,19 +184,10 @@ TEST(Convergence, TranslationMovedBeyondItsPriorIsNamed) {
 // estimate, and are not observable once it reaches the threshold; the axis along travel keeps
 // the polish's numbers; without updates the covariance stands.
 TEST(Convergence, ReportedTranslationStdIsAtLeastTheRefinementsSpread) {
-  ConvergenceVerdict verdict;
-  RefineResult& refine = verdict.refine;
-  refine.covariance_ok = true;
-  for (int k = 0; k < kNumAxes; ++k) {
-    refine.std_dev[k] = k < 3 ? 0.03 : k < 6 ? 0.008 : 0.0004;
-    refine.observable[k] = true;
-  }
+  ConvergenceVerdict verdict =
+      VerdictWithCovariance(0.03, 0.008, Eigen::Vector3d::UnitZ(), 0.02, 0.002);
   TimeForwardPair& pair = verdict.time_forward;
-  pair.measured = true;
   pair.separated = true;
-  pair.forward_camera = Eigen::Vector3d::UnitZ();
-  pair.forward_std_m = 0.02;
-  pair.time_offset_std_s = 0.002;
   verdict.time_offset_observable = true;
   const ReportedUncertainty plain = ReportUncertainty(verdict, true, 0.04);
   EXPECT_DOUBLE_EQ(plain.std_dev[3], 0.008);

@@ -152,7 +152,7 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
       TranslationMoveBeyondPrior(initial, verdict.estimate, options.max_translation_move_sigmas,
                                  online.refine.prior_sigma_translation_m);
 
-  char text[256];
+  char text[512];
   if (used.empty()) {
     verdict.reason = "not converged: all " + std::to_string(verdict.skipped_frames) +
                      " frames were skipped" +
@@ -189,8 +189,7 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   } else if (!profile_problem.empty()) {
     verdict.reason = "not converged: " + profile_problem;
   } else if (moved.axis >= 0) {
-    char long_text[512];
-    std::snprintf(long_text, sizeof(long_text),
+    std::snprintf(text, sizeof(text),
                   "not converged: the translation moved %+.1f cm from the start on %s, more than "
                   "%.1f times its prior's %.1f cm: the data overrules the prior (a wrong time "
                   "offset can show up as a sideways shift); if the start may be that far off, "
@@ -198,7 +197,7 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                   100 * moved.move_m, kAxisNames[3 + moved.axis],
                   options.max_translation_move_sigmas,
                   100 * online.refine.prior_sigma_translation_m);
-    verdict.reason = long_text;
+    verdict.reason = text;
   } else if (last.health < options.min_final_health) {
     std::snprintf(text, sizeof(text),
                   "not converged: health %.3f < %.2f (the estimate is not a clear optimum of the "
