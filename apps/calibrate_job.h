@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,9 @@ struct CalibrateOutcome {
   FrameReport polish;                 ///< the final refinement (OnlineCalibrator::Polish), if run
   bool time_offset_estimated = true;  ///< δ was estimated (else held at δ0)
   TimeForwardPair time_forward;       ///< δ against the forward translation (the verdict's)
+  // Per axis (kAxisNames order), whether the estimate is observed (result.json's `observable`):
+  // an axis that is not rests on its start or its prior and is shown as held.
+  std::array<bool, kNumAxes> observable{};
   std::vector<std::string> pictures;
   double mean_frame_ms = 0;
 };

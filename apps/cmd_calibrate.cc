@@ -1,4 +1,4 @@
-// stcalib calibrate: online calibration of a drive (method.md §9).
+// stcalib calibrate: online calibration of a drive (docs/method.md §9).
 #include <glog/logging.h>
 #include <unistd.h>
 
@@ -313,12 +313,15 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   outcome->alias_suspect = verdict.time_offset_profile.alias_suspect;
   outcome->time_offset_estimated = job.online.refine.estimate_time_offset;
   outcome->time_forward = verdict.time_forward;
+  const ReportedUncertainty reported = ReportUncertainty(
+      verdict, outcome->time_offset_estimated, job.online.refine.observable_translation_m);
+  outcome->observable = reported.observable;
   auto verdict_code = [&]() {
     if (outcome->converged) return kExitOk;
     std::fprintf(stderr, "stcalib calibrate: %s\n", outcome->reason.c_str());
     return kExitFailure;
   };
-  // method.md §9: --out is optional; without it nothing is written (the caller prints the
+  // docs/method.md §9: --out is optional; without it nothing is written (the caller prints the
   // estimate) and none of the files' contents are made.
   if (job.out_dir.empty()) return verdict_code();
   const TimeOffsetProfile& profile = verdict.time_offset_profile;
@@ -367,8 +370,6 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     fs::remove(out + "/" + kTimeOffsetFileName, ec);
   }
   nlohmann::json std_json, observable_json;
-  const ReportedUncertainty reported = ReportUncertainty(
-      verdict, outcome->time_offset_estimated, job.online.refine.observable_translation_m);
   for (int k = 0; k < kNumAxes; ++k) {
     std_json[kAxisNames[k]] =
         reported.has_std[k] ? nlohmann::json(reported.std_dev[k]) : nlohmann::json(nullptr);
@@ -389,6 +390,10 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
                                                     ? nlohmann::json(refine.std_dev[kTime])
                                                     : nlohmann::json(nullptr)}};
   const Eigen::Vector3d rpy_deg = MountRollPitchYawDeg(outcome->estimate.T_camera_lidar.linear());
+  nlohmann::json rules_json = nlohmann::json::array();
+  for (const RuleOutcome& rule : verdict.rules) {
+    rules_json.push_back({{"name", rule.name}, {"passed", rule.passed}, {"detail", rule.detail}});
+  }
   // Per frame, over all frames (those without an update count as 0 ms), and per update.
   double search_ms = 0, refine_ms = 0, update_ms = 0;
   int updates = 0;
@@ -417,6 +422,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"suppressed_health_check", health_check_json},
       {"converged", outcome->converged},
       {"reason", outcome->reason},
+      {"phase", PhaseName(calibrator.phase())},
+      {"verdict_rules", rules_json},
       {"alias_suspect", outcome->alias_suspect},
       {"time_offset_peak_s", profile.best_s},
       {"alias_second_peak_s", profile.second_peak_s},
@@ -453,8 +460,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   std::string csv =
       "frame,accepted,coarse_search,points,gray_rate,health,roll_deg,pitch_deg,yaw_deg,x_m,y_m,z_m,"
       "time_offset_s,rotation_error_deg,translation_error_m,time_offset_error_s,search_ms,refine_"
-      "ms,"
-      "reason\n";
+      "ms,phase,reason\n";
   std::vector<double> xs, rot_err, trans_err_cm, dt_ms, roll_e, pitch_e, yaw_e;
   for (const FrameReport& r : outcome->reports) {
     const CalibrationError e = ComputeCalibrationError(r.after, outcome->reference_state);
@@ -468,7 +474,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
         r.after.T_camera_lidar.translation().y(), r.after.T_camera_lidar.translation().z(),
         r.after.time_offset_s, e.rotation_deg, e.translation_norm_m, e.time_offset_s, r.search_ms,
         r.refine_ms);
-    csv += row + Csv(r.reason) + "\n";
+    csv += row + PhaseName(r.phase) + "," + Csv(r.reason) + "\n";
     xs.push_back(r.frame);
     rot_err.push_back(e.rotation_deg);
     roll_e.push_back(e.roll_deg);

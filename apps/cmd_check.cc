@@ -1,4 +1,4 @@
-// stcalib check: does the stored calibration still hold? (method.md §7 and §9)
+// stcalib check: does the stored calibration still hold? (docs/method.md §7 and §9)
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>

@@ -55,18 +55,42 @@ int RunDemo() {
   const int code = RunCalibrateJob(job, &outcome);
   if (outcome.reports.empty()) return code;
 
-  auto row = [](const char* name, const CalibrationError& e, double delta_ms) {
-    std::printf("  %-9s %8.3f %8.3f %8.3f %8.3f | %7.1f %7.1f %7.1f | %8.2f\n", name,
-                e.rotation_deg, e.roll_deg, e.pitch_deg, e.yaw_deg, 100 * e.translation_m.x(),
-                100 * e.translation_m.y(), 100 * e.translation_m.z(), delta_ms);
+  // `observable`: per axis (kAxisNames order), whether to print the value; an axis the tool
+  // could not observe is shown as "held" (it rests on its start or prior, it is no estimate).
+  auto row = [](const char* name, const CalibrationError& e, double delta_ms,
+                const std::array<bool, kNumAxes>& observable) {
+    const double values[kNumAxes] = {e.roll_deg,
+                                     e.pitch_deg,
+                                     e.yaw_deg,
+                                     100 * e.translation_m.x(),
+                                     100 * e.translation_m.y(),
+                                     100 * e.translation_m.z(),
+                                     delta_ms};
+    char cells[kNumAxes][16];
+    for (int k = 0; k < kNumAxes; ++k) {
+      const int width = k < 3 ? 8 : (k < 6 ? 7 : 8);
+      if (observable[k]) {
+        std::snprintf(cells[k], sizeof(cells[k]), k < 3 ? "%*.3f" : (k < 6 ? "%*.1f" : "%*.2f"),
+                      width, values[k]);
+      } else {
+        std::snprintf(cells[k], sizeof(cells[k]), "%*s", width, "held");
+      }
+    }
+    std::printf("  %-9s %8.3f %s %s %s | %s %s %s | %s\n", name, e.rotation_deg, cells[0], cells[1],
+                cells[2], cells[3], cells[4], cells[5], cells[6]);
   };
+  std::array<bool, kNumAxes> all;
+  all.fill(true);
   std::printf(
       "\n            rotation error [deg]                 | translation error [cm] | time offset "
       "[ms]\n");
   std::printf("            total     roll    pitch      yaw |       x       y       z |\n");
-  row("truth", CalibrationError(), 1000 * outcome.reference_state.time_offset_s);
-  row("start", outcome.initial_error, 1000 * outcome.initial.time_offset_s);
-  row("estimate", outcome.error, 1000 * outcome.estimate.time_offset_s);
+  row("truth", CalibrationError(), 1000 * outcome.reference_state.time_offset_s, all);
+  row("start", outcome.initial_error, 1000 * outcome.initial.time_offset_s, all);
+  row("estimate", outcome.error, 1000 * outcome.estimate.time_offset_s, outcome.observable);
+  std::printf(
+      "  (\"held\": not observable in this drive, the value rests on its start or prior; "
+      "see result.json's std and observable)\n");
   std::printf("  (time offset column: the value itself; its error is %+.2f ms)\n",
               1000 * outcome.error.time_offset_s);
   std::printf("%s", TimeOffsetPriorNote(outcome).c_str());

@@ -1,4 +1,5 @@
-// stcalib eval-temporal: the paper's Table I against ROS ApproximateTime pairing (method.md §8).
+// stcalib eval-temporal: the paper's Table I against ROS ApproximateTime pairing (docs/method.md
+// §8).
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -86,7 +87,7 @@ cv::Mat Curves(const TemporalEvalResult& r) {
 
 int RunEvalTemporal() {
   const char* kCommand = "eval-temporal";
-  // method.md §9: --out is optional; without it the tables are printed and nothing is written.
+  // docs/method.md §9: --out is optional; without it the tables are printed and nothing is written.
   const bool write = !FLAGS_out.empty();
   Drive drive;
   Status status = OpenDriveFromFlags(&drive);
@@ -111,7 +112,7 @@ int RunEvalTemporal() {
       return ReportError(kCommand, Status::Error(FLAGS_out + ": cannot create output folder"));
     }
   }
-  std::string md = "# Temporal evaluation (method.md §8)\n\nDrive " + drive.drive_dir +
+  std::string md = "# Temporal evaluation (docs/method.md §8)\n\nDrive " + drive.drive_dir +
                    ", LiDAR decimated by " + std::to_string(options.lidar_decimation) + " and " +
                    std::to_string(options.lidar_delay_s) + " s late.\n\n";
   TemporalEvalResult all, static_only;

@@ -1,4 +1,5 @@
-// Reading and projecting one KITTI frame (method.md §10: decoding a PNG ≈ 8 ms, a .bin ≈ 0.1 ms).
+// Reading and projecting one KITTI frame (docs/method.md §10: decoding a PNG ≈ 8 ms, a .bin ≈ 0.1
+// ms).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>

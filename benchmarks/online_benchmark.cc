@@ -140,7 +140,7 @@ void BM_RotationGridCachedNewFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_RotationGridCachedNewFrame)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
 
-// The health score (method.md §7): 728 neighbours of the estimate scored over N frames; an
+// The health score (docs/method.md §7): 728 neighbours of the estimate scored over N frames; an
 // online update measures it before and after, and every 6-DoF search step scores as many.
 // The frames are pruned to the image as the calibrator's window is: every point then projects
 // and is sampled (over the whole sweep most points fall behind the camera and cost nothing, which

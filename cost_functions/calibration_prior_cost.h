@@ -8,7 +8,7 @@
 namespace stcalib {
 
 // Weak prior tying the refinement to a reference calibration (the search result, or the mount
-// drawing), method.md §6:
+// drawing), docs/method.md §6:
 //
 //   Δq = q0⁻¹ ⊗ q               rotation from the reference, on the LiDAR side
 //   r_rot   = 2·sign(Δq_w)·Δq_xyz / σ_rot     (≈ the rotation vector of R0ᵀ·R for small angles)
@@ -17,7 +17,7 @@ namespace stcalib {
 //
 // Seven residuals, dimensionless. Blocks as in EdgeAlignmentCost: [qx, qy, qz, qw, tx, ty, tz]
 // and δ. Holding translation with σ_trans keeps δ and the forward translation, which are nearly
-// inseparable on a straight road (method.md §10), from drifting along their ridge together.
+// inseparable on a straight road (docs/method.md §10), from drifting along their ridge together.
 class CalibrationPriorCost {
  public:
   CalibrationPriorCost(const Eigen::Quaterniond& q0, const Eigen::Vector3d& t0, double delta0_s,

@@ -22,13 +22,13 @@ namespace stcalib {
 using DistanceGrid = ceres::Grid2D<float, 1>;
 using DistanceInterpolator = ceres::BiCubicInterpolator<DistanceGrid>;
 
-// Edge-alignment residuals of one frame's LiDAR edge points (method.md §6), one residual per
+// Edge-alignment residuals of one frame's LiDAR edge points (docs/method.md §6), one residual per
 // point, all in one residual block.
 //
 // A LiDAR edge point p, de-skewed to its sweep stamp t_l, is carried to the image time t_c by the
 // LiDAR's own motion and then into the camera:
 //
-//   e        = (t_l + δ) − t_c = e0 + δ                       (method.md §2; one e per frame)
+//   e        = (t_l + δ) − t_c = e0 + δ                       (docs/method.md §2; one e per frame)
 //   p_m      = Tv(e) · p,       Tv(e) = Exp(e · ξ_L)           (ξ_L = (ω, v): LiDAR body twist, §3)
 //   p_c      = R · p_m + t,     R = R(q / |q|)
 //   h        = P · R_rect · p_c + p4,   (u, v) = (h_x / h_z, h_y / h_z)

@@ -281,7 +281,7 @@ TEST(Convergence, SuppressedCheckRefusesAKittiFalseOptimumThePlainMapsLike) {
   EXPECT_GE(plain_wrong_health, 0.8);
 }
 
-// The texture trap of method.md §10 and its cure: on the shared KITTI frames the clipped
+// The texture trap of docs/method.md §10 and its cure: on the shared KITTI frames the clipped
 // texture-suppressed score still rises for degrees away from KITTI's calibration (moving points
 // into foliage pays), the band-pass score peaks at the calibration on every rotation axis.
 TEST(Score, KittiBandPassPeaksAtTheCalibrationTheClippedMapDoesNot) {
@@ -318,6 +318,47 @@ TEST(Score, KittiBandPassPeaksAtTheCalibrationTheClippedMapDoesNot) {
     worst_clipped = std::max(worst_clipped, std::abs(c.best_deg));
   }
   EXPECT_GE(worst_clipped, 2.0);
+}
+
+}  // namespace
+}  // namespace stcalib
+
+namespace stcalib {
+namespace {
+
+// The rotation's block jackknife on KITTI frames 21-29 at KITTI's calibration: three blocks of
+// three frames, a spread of a few hundredths to tenths of a degree; the same frame repeated
+// leaves nothing to spread (every block left out keeps the same data); too few frames for two
+// blocks measure nothing.
+TEST(Convergence, RotationJackknifeOverBlocksOfFrames) {
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
+  const std::vector<std::shared_ptr<const CalibrationFrame>> loaded =
+      testing::LoadCalibrationFrames(drive, FrameSourceOptions(),
+                                     {21, 22, 23, 24, 25, 26, 27, 28, 29});
+  ASSERT_EQ(loaded.size(), 9u);
+  std::vector<const CalibrationFrame*> frames;
+  for (const auto& frame : loaded) frames.push_back(frame.get());
+  CalibrationState kitti;
+  kitti.T_camera_lidar = drive.T_camera_lidar;
+  RefineOptions options;
+  options.loss = RefineOptions::Loss::kTukey;
+  options.loss_scale_px = 5.0;
+  const RotationJackknife spread = JackknifeRotation(frames, kitti, kitti, options, 3);
+  EXPECT_EQ(spread.frames, 9);
+  EXPECT_EQ(spread.blocks, 3);
+  EXPECT_EQ(spread.failed, 0);
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_GT(spread.std_deg[axis], 1e-4) << axis;
+    EXPECT_LT(spread.std_deg[axis], 0.5) << axis;
+  }
+  const std::vector<const CalibrationFrame*> same(6, frames[4]);
+  const RotationJackknife none = JackknifeRotation(same, kitti, kitti, options, 3);
+  EXPECT_EQ(none.blocks, 2);
+  EXPECT_LT(none.std_deg.norm(), 1e-6);
+  EXPECT_EQ(JackknifeRotation({frames[0], frames[1], frames[2]}, kitti, kitti, options, 3).frames,
+            0);
 }
 
 }  // namespace

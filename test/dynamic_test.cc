@@ -328,7 +328,7 @@ TEST(DynamicFilter, OlderReferenceRemovesMoversWhereItSawThroughAndKeepsWhatItDi
   EXPECT_EQ(blind.removed_points, static_cast<int>(current.size()));
 }
 
-// A drive's LiDAR stamps are δ before the true capture times (method.md §2), so a local map
+// A drive's LiDAR stamps are δ before the true capture times (docs/method.md §2), so a local map
 // merged with the poses at the stamps puts an earlier sweep where the vehicle's motion between
 // the stamps, not between the captures, says. While it accelerates or turns the two differ by
 // centimetres at δ = 60 ms; RelativeLidarPoseRate places the points to first order in δ (the

@@ -1,4 +1,4 @@
-// Health check (method.md §7): KITTI's own calibration holds; 0.5° and 1° off are told apart.
+// Health check (docs/method.md §7): KITTI's own calibration holds; 0.5° and 1° off are told apart.
 #include "core/online/health_check.h"
 
 #include <gtest/gtest.h>

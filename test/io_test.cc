@@ -102,8 +102,8 @@ TEST(KittiReaders, DriveIndexesThirtyFramesWithMonotonicStamps) {
   EXPECT_EQ(FormatKittiTimestamp(drive.camera_stamps_ns[0]), "2011-09-26 13:10:51.168593664");
   EXPECT_EQ(FormatKittiTimestamp(drive.lidar_stamps_ns[0]), "2011-09-26 13:10:51.158069617");
   for (size_t i = 0; i < drive.NumFrames(); ++i) {
-    // method.md §10: the velodyne stamp is the middle of start and end (to 1 µs), the sweep lasts
-    // about 103.6 ms, and the camera stamp is about 10.5 ms after the velodyne stamp.
+    // docs/method.md §10: the velodyne stamp is the middle of start and end (to 1 µs), the sweep
+    // lasts about 103.6 ms, and the camera stamp is about 10.5 ms after the velodyne stamp.
     const StampNs mid = (drive.lidar_start_stamps_ns[i] + drive.lidar_end_stamps_ns[i]) / 2;
     EXPECT_NEAR(static_cast<double>(drive.lidar_stamps_ns[i] - mid), 0.0, 1000.0);
     EXPECT_NEAR((drive.lidar_end_stamps_ns[i] - drive.lidar_start_stamps_ns[i]) * 1e-6, 103.6, 1.0);

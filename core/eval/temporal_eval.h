@@ -10,16 +10,16 @@
 
 namespace stcalib {
 
-// The paper's Table I (method.md §8): LiDAR decimated to a lower rate and delayed; images paired
-// by ApproximateTime (`filter_cloud`); the paired sweep carried to the image time by the motion
-// model with the calibrated δ (`infer_cloud`); sweeps predicted for the images ApproximateTime
-// left unpaired (`infer_cloud_interpolation`). Each is compared with the real sweep at the image
-// time, held out.
+// The paper's Table I (docs/method.md §8): LiDAR decimated to a lower rate and delayed; images
+// paired by ApproximateTime (`filter_cloud`); the paired sweep carried to the image time by the
+// motion model with the calibrated δ (`infer_cloud`); sweeps predicted for the images
+// ApproximateTime left unpaired (`infer_cloud_interpolation`). Each is compared with the real sweep
+// at the image time, held out.
 struct TemporalEvalOptions {
   int lidar_decimation = 2;        ///< keep every n-th sweep
   double lidar_delay_s = 0.1;      ///< the kept sweeps' stamps are this late [s]
   double drive_time_offset_s = 0;  ///< the drive's own δ (simulated truth or a calibration) [s]
-  bool remove_dynamic = false;     ///< drop dynamic points (method.md §5) from every cloud
+  bool remove_dynamic = false;     ///< drop dynamic points (docs/method.md §5) from every cloud
   double max_range_m = 120.0;      ///< points beyond are left out of every metric [m]
   int nn_stride = 2;               ///< every n-th predicted point is queried for the NN metric
   NdtOptions ndt;

@@ -9,13 +9,13 @@
 
 namespace stcalib {
 
-// Dynamic points (method.md §5): with the previous sweep motion-compensated into the current one,
-// a static point finds a close neighbour in it and a moving one does not. Points farther than
-// τ(r) = τ0 + k·r from their nearest previous neighbour (KD-tree) are flagged — but only where
-// the previous sweep saw through that place (its range in that direction, seen from its own
-// viewpoint, is longer): structure that was merely hidden before (disocclusion) is not moving.
-// The current non-ground points are clustered (Euclidean, on a voxel grid) and whole clusters
-// with enough flagged points are removed.
+// Dynamic points (docs/method.md §5): with the previous sweep motion-compensated into the current
+// one, a static point finds a close neighbour in it and a moving one does not. Points farther than
+// τ(r) = τ0 + k·r from their nearest previous neighbour (KD-tree) are flagged — but only where the
+// previous sweep saw through that place (its range in that direction, seen from its own viewpoint,
+// is longer): structure that was merely hidden before (disocclusion) is not moving. The current
+// non-ground points are clustered (Euclidean, on a voxel grid) and whole clusters with enough
+// flagged points are removed.
 struct DynamicFilterOptions {
   double tau0_m = 0.15;          ///< τ0 [m]
   double tau_per_range = 0.008;  ///< k [m/m]: beam spacing grows with range

@@ -8,8 +8,8 @@
 
 namespace stcalib {
 
-// Ground removal (method.md §4): a RANSAC plane through the nearby, low returns, refined by least
-// squares on its inliers; points within `band_m` of it (or below it) are ground.
+// Ground removal (docs/method.md §4): a RANSAC plane through the nearby, low returns, refined by
+// least squares on its inliers; points within `band_m` of it (or below it) are ground.
 struct GroundOptions {
   double max_fit_range_m = 30.0;     ///< only returns this close (horizontally) fit the plane [m]
   double max_tilt_deg = 15.0;        ///< plane normals further than this from LiDAR z are rejected

@@ -9,13 +9,13 @@
 
 namespace stcalib {
 
-// Image line features (method.md §4): grayscale → (blur) → edges → distance transform D →
+// Image line features (docs/method.md §4): grayscale → (blur) → edges → distance transform D →
 // inverse distance transform IDT = 255·max(0, 1 − D/basin), smoothed. Projected LiDAR edge
 // points read the IDT (higher = nearer an edge); the refinement samples the smoothed, capped
 // distance map with a bicubic interpolator.
 struct ImageFeatureOptions {
   enum class Detector {
-    kCanny,     ///< Canny edges (fast per-frame path, ≈ 5 ms on 1242×375)
+    kCanny,     ///< Canny edges (the fast per-frame path; docs/tuning.md#canny-timing)
     kLsd,       ///< OpenCV LSD segments drawn into the mask
     kFastLine,  ///< cv::ximgproc FastLineDetector segments drawn into the mask
   };
@@ -42,7 +42,8 @@ struct ImageFeatureOptions {
   // idt_bandpass, distance_px). Whoever reads only the oriented maps saves a distance transform,
   // a blur, a band-pass and a min.
   bool unsplit_maps = true;
-  bool precise_distance = false;  ///< exact Euclidean DT (5.6 ms) instead of the 3×3 mask (3.3 ms)
+  bool precise_distance = false;  ///< exact Euclidean DT instead of the 3×3 mask, slower
+                                  ///< (docs/tuning.md#precise-distance)
   // Rectangle of interest (x, y, w, h) [px]; empty = whole image. Outside it the maps are flat.
   cv::Rect region_of_interest;
 
@@ -95,7 +96,8 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
 // along an axis and 1.3693 along a diagonal, in 16-bit fixed point); the output (CV_32F) equals
 // cv::distanceTransform(edges == 0, DIST_L2, DIST_MASK_3) bit for bit. Paths stay inside the
 // image. Without any edge pixel every distance is the metric's "unreachable" value, as OpenCV's.
-// Two raster passes whose row-to-row part vectorises: a third of OpenCV's time on 1242×375.
+// Two raster passes whose row-to-row part vectorises, faster than OpenCV's (measured:
+// docs/tuning.md#chamfer-distance).
 void ChamferDistance(const cv::Mat& edges, cv::Mat* distance_px);
 
 // IDT from a distance map: 255·max(0, 1 − D/basin), Gaussian-smoothed.
@@ -104,9 +106,8 @@ cv::Mat InverseDistanceTransform(const cv::Mat& distance_px, double basin_px, do
 // IDT minus its wide blur (computed at reduced resolution): a band-pass map with zero mean over
 // any patch much wider than sigma_px. Dense texture (foliage) averages to zero, an isolated edge
 // is a peak in a negative moat. As a score it does not reward moving points into edge-dense
-// regions; the clipped form (SuppressTexture) keeps the positive half of the texture and does
-// (on the shared KITTI frames the clipped map's score still rose towards +6° pitch, the band-pass
-// map peaks at KITTI's calibration in every roll/pitch/yaw slice).
+// regions; the clipped form (SuppressTexture) keeps the positive half of the texture and does.
+// Measured: docs/tuning.md#band-pass
 cv::Mat BandPass(const cv::Mat& idt, double sigma_px);
 // max(0, BandPass(idt, sigma_px)).
 cv::Mat SuppressTexture(const cv::Mat& idt, double sigma_px);

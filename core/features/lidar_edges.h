@@ -18,11 +18,11 @@ enum class PointUse : uint8_t {
   kDynamic = 2,  ///< moving object: never an edge, and no edge is declared against it
 };
 
-// Depth-discontinuity edges (method.md §4). Along a ring a jump in range marks a vertical edge
+// Depth-discontinuity edges (docs/method.md §4). Along a ring a jump in range marks a vertical edge
 // (an object's left/right silhouette); between vertically adjacent rings at the same azimuth it
 // marks a horizontal one (tops and overhangs). The nearer side is kept, and only where it is
 // smooth: its next points away from the jump continue the surface. Foliage, whose returns
-// scatter in depth, fails that test (method.md §10).
+// scatter in depth, fails that test (docs/method.md §10).
 struct LidarEdgeOptions {
   double min_range_m = 2.0;          ///< nearer edge points are dropped [m]
   double max_range_m = 70.0;         ///< farther edge points are dropped [m]
@@ -39,32 +39,15 @@ struct LidarEdgeOptions {
   int run_support = 1;
   double run_azimuth_deg = 0.6;       ///< azimuth window for a vertical-edge neighbour [deg]
   double run_range_tolerance = 0.05;  ///< relative range difference allowed within a run
-  // Folds: a horizontal edge below the sensor whose beam above returns at nearly its own height
-  // (within fold_height_tolerance_m; 0 = mark none) and at most fold_max_depth_m farther is
-  // marked LidarEdges::fold. With a depth of a few metres these are the front corners of
-  // horizontal tops seen from above (a car's roof or bonnet): the beam above lands on the top
-  // itself, so the point sits at the corner while the image outline is the top's far side, a few
-  // pixels higher (a 2-5 cm vertical bias on simulated drives). Unbounded, they also take the
-  // tops' outlines against a background at their own height, which near-horizontal beams cannot
-  // tell from a corner (a wall 20 m behind returns within a few cm of the top's height). Both are
-  // marked by default: with the 3 m bound (corners only) KITTI ended within 0.2° of its
-  // calibration on 6 of 16 starts, unbounded on 11 (OnlineCalibratorOptions::folds); on 40-frame
-  // simulated drives the two are alike. [m]
+  // Folds (LidarEdges::fold): horizontal edges below the sensor whose beam above returns within
+  // fold_height_tolerance_m of their height (0 = mark none), at most fold_max_depth_m farther:
+  // near, corners of tops seen from above (the image outline is the top's far side); unbounded by
+  // default, also tops against a background at their height [m]. docs/tuning.md#fold-max-depth
   double fold_height_tolerance_m = 0.08;
   double fold_max_depth_m = std::numeric_limits<double>::infinity();
-  // A fold whose beam above lands on the top at most fold_top_depth_m farther (0 = none) is
-  // moved from the corner to the top's far side, where the outline is: up the beams that land on
-  // the top at its height (each at most this much farther than the last), to the last of them,
-  // then half a beam up, as any horizontal edge; dropped when the walk meets an edge point (the
-  // far side is one already). Against the simulator's scene the moved folds lie −0.07° from the
-  // outline on average, the corners −0.49° (LidarEdges.FoldsMovedToTheFarSideOfTheirTop...).
-  // The corners biased the vertical translation: on scripts/sweep's 14 simulated drives (folds
-  // kept throughout) y ended −5.0..−0.4 cm off (mean −2.9 cm), and −1.3..+1.5 cm (−0.4 cm)
-  // moved; translation within 3 cm on 6 drives (3), rotation within 0.1° on 10 (9). KITTI, 48
-  // starts (1–3°): mean 0.182° (0.179°), within 0.2° on 35 (41); its roll, −0.16..−0.18° from
-  // the drive's calibration in both, decides that count. 1.5 m is about a car's bonnet or roof;
-  // beyond it the beam above more often meets another surface at the same height: with 3 m KITTI
-  // ended at a mean 0.189° on 32 starts, with 6 m at 0.223° on 16. [m]
+  // A fold is moved up the beams that land on its top at its height (each at most this much
+  // farther than the last) to the top's far side, where the image outline is; 0 = none. 1.5 m is
+  // about a car's bonnet or roof [m]. Measured: docs/tuning.md#fold-top-depth
   double fold_top_depth_m = 1.5;
 
   Status Validate() const;

@@ -59,7 +59,7 @@ LidarFrameFeatures ComputeLidarFrameFeatures(LidarScan scan, double stamp_s,
                                              const std::vector<ReferenceFeatures>& references,
                                              const LidarFeatureOptions& options);
 
-// Local map (method.md §4): the edges of `sweeps` consecutive sweeps ending at `frame`, merged
+// Local map (docs/method.md §4): the edges of `sweeps` consecutive sweeps ending at `frame`, merged
 // into the frame of the last one, with oxts poses or, when `use_ndt` is set, refined by NDT.
 struct LocalMapOptions {
   int sweeps = 3;

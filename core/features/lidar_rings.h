@@ -8,8 +8,8 @@
 namespace stcalib {
 
 // Beams (rings) of a spinning-LiDAR sweep stored in KITTI order, which has no ring field
-// (method.md §10): each laser's points run counter-clockwise from just left of straight ahead all
-// the way round to just right of it, and lasers follow each other. A laser ends where the
+// (docs/method.md §10): each laser's points run counter-clockwise from just left of straight ahead
+// all the way round to just right of it, and lasers follow each other. A laser ends where the
 // azimuth, having passed the ±180° wrap, crosses from negative to positive.
 struct ScanRings {
   std::vector<uint16_t> ring;              ///< ring of every point, in file order
@@ -33,7 +33,7 @@ std::vector<double> PointTimesFromAzimuth(const ScanRings& rings, double sweep_d
 // The azimuth step from `from` to `to` (float atan2 values, within a float ulp of (−π, π] as
 // ScanRings stores them) wrapped into [−π, π] [rad]: std::remainder(to − from, 2π) bit for bit
 // (the difference lies within about ±2π, and subtracting 2π from a value in (π, 2π + ulp] is exact
-// by Sterbenz's lemma), without its cost (about 2 % of a frame's features in perf).
+// by Sterbenz's lemma), without its cost (measured: docs/tuning.md#wrapped-azimuth-step).
 inline double WrappedAzimuthStep(float from, float to) {
   const double d = to - from;  // the float difference, as before
   if (d > M_PI) return d - 2 * M_PI;

@@ -10,7 +10,7 @@
 namespace stcalib {
 
 // One LiDAR sweep as stored in a KITTI velodyne .bin: float32 x, y, z, reflectance per point,
-// in the LiDAR frame, in scan order (method.md §10).
+// in the LiDAR frame, in scan order (docs/method.md §10).
 struct LidarScan {
   std::vector<Eigen::Vector3d> points_lidar;  ///< [m]
   std::vector<float> reflectance;             ///< [0, 1]

@@ -24,7 +24,7 @@ Rigid3d RelativeLidarPose(const LidarPoseFunction& T_world_lidar, double t_to_s,
 // How that relative pose changes when both stamps shift together: d/dδ of
 // RelativeLidarPose(T_world_lidar, t_to + δ, t_from + δ) at δ = 0, as [∂R/∂δ | ∂t/∂δ] [1/s, m/s]
 // (central difference over ±5 ms). Zero for a constant twist; not zero while the vehicle
-// accelerates or turns in or out. The LiDAR's stamps are off by the time offset δ (method.md
+// accelerates or turns in or out. The LiDAR's stamps are off by the time offset δ (docs/method.md
 // §2), so a local map merged at the stamps is merged at the wrong times: a point p of the sweep
 // t_from sits at T·p + δ·(∂R·p + ∂t) in the sweep t_to's frame, to first order.
 Eigen::Matrix<double, 3, 4> RelativeLidarPoseRate(const LidarPoseFunction& T_world_lidar,

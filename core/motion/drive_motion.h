@@ -12,7 +12,7 @@ namespace stcalib {
 // The LiDAR's motion over a drive. Two sources:
 // - oxts (Create): the oxts packets and calib_imu_to_velo.txt, interpolated between packets;
 // - scan registration (CreateFromScans, for drives without oxts): each sweep registered to the
-//   previous one with NDT, and a constant velocity between consecutive sweep stamps (method.md
+//   previous one with NDT, and a constant velocity between consecutive sweep stamps (docs/method.md
 //   §3's constant-velocity model), extrapolated with the nearest segment's velocity.
 // Times are seconds relative to a reference stamp (the first oxts or LiDAR stamp).
 class DriveMotion {

@@ -10,7 +10,7 @@
 namespace stcalib {
 
 // The LiDAR's velocity in its own frame (a body twist): p_L(t) = Tv · p_L(t + e) with
-// Tv = T_L(t)←L(t+e) = Exp(e · ξ), ξ = (ω, v) (method.md §3).
+// Tv = T_L(t)←L(t+e) = Exp(e · ξ), ξ = (ω, v) (docs/method.md §3).
 struct LidarTwist {
   Eigen::Vector3d angular_rad_s = Eigen::Vector3d::Zero();  ///< ω [rad/s]
   Eigen::Vector3d linear_m_s = Eigen::Vector3d::Zero();     ///< v [m/s]

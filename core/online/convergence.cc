@@ -19,31 +19,261 @@ Status ConvergenceOptions::Validate() const {
   return health_check.Validate();
 }
 
-TranslationMove TranslationMoveBeyondPrior(const CalibrationState& initial,
-                                           const CalibrationState& estimate, double max_sigmas,
-                                           double prior_sigma_m) {
+TranslationMove TranslationMoveBeyond(const Eigen::Vector3d& move_m, double max_sigmas,
+                                      double prior_sigma_m) {
   TranslationMove moved;
   if (!(max_sigmas > 0)) return moved;
-  const Eigen::Vector3d move =
-      estimate.T_camera_lidar.translation() - initial.T_camera_lidar.translation();
   double largest_m = max_sigmas * prior_sigma_m;
   for (int i = 0; i < 3; ++i) {
-    if (std::abs(move[i]) > largest_m) {
-      largest_m = std::abs(move[i]);
+    if (std::abs(move_m[i]) > largest_m) {
+      largest_m = std::abs(move_m[i]);
       moved.axis = i;
-      moved.move_m = move[i];
+      moved.move_m = move_m[i];
     }
   }
   return moved;
 }
 
-ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
-                                    const std::vector<FrameReport>& reports,
-                                    const CalibrationState& initial,
-                                    const OnlineCalibratorOptions& online,
-                                    const ConvergenceOptions& options) {
-  ConvergenceVerdict verdict;
-  verdict.estimate = calibrator.state();
+TranslationMove TranslationMoveBeyondPrior(const CalibrationState& initial,
+                                           const CalibrationState& estimate, double max_sigmas,
+                                           double prior_sigma_m) {
+  return TranslationMoveBeyond(
+      estimate.T_camera_lidar.translation() - initial.T_camera_lidar.translation(), max_sigmas,
+      prior_sigma_m);
+}
+
+namespace {
+
+// A still-acquiring run may claim when its last rotation grid agreed with the estimate over
+// every frame the run used, and over at least this many: one frame's optimum scatters by about
+// 1° (docs/method.md §10), a few frames' side peaks lie 3-4° off, and ten frames of a structured
+// street settle within 0.3°.
+constexpr int kMinAgreementFrames = 8;
+
+// Frames that share sweeps through their local maps: 1 + the oldest sweep any point of `frames`
+// comes from (CalibrationFrame::sweep_ages; 1 without ages). The jackknife leaves out blocks of
+// this many frames, so that a block's sweeps are not all still in the frames it keeps.
+int SharedSweepFrames(const std::vector<const CalibrationFrame*>& frames) {
+  int oldest = 0;
+  for (const CalibrationFrame* frame : frames) {
+    for (uint8_t age : frame->sweep_ages) oldest = std::max<int>(oldest, age);
+  }
+  return oldest + 1;
+}
+
+std::string Format(const char* format, double a, double b = 0, double c = 0, double d = 0) {
+  char text[512];
+  std::snprintf(text, sizeof(text), format, a, b, c, d);
+  return text;
+}
+
+using Rule = RuleOutcome (*)(const ConvergenceEvidence&, const ConvergenceOptions&);
+
+RuleOutcome FramesUsed(const ConvergenceEvidence& e, const ConvergenceOptions&) {
+  if (e.used_frames > 0) return {"frames_used", true, std::to_string(e.used_frames) + " used"};
+  return {"frames_used", false,
+          "all " + std::to_string(e.skipped_frames) + " frames were skipped" +
+              (e.first_reason.empty() ? "" : " (first reason: " + e.first_reason + ")")};
+}
+
+RuleOutcome Features(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
+  const std::string points = std::to_string(e.last_points) + " LiDAR edge points in the image";
+  if (e.last_points >= o.min_points) return {"features", true, points};
+  return {"features", false, "no usable features (" + points + ")"};
+}
+
+RuleOutcome Updated(const ConvergenceEvidence& e, const ConvergenceOptions&) {
+  if (e.updates > 0) return {"updated", true, std::to_string(e.updates) + " updates"};
+  // Not even one update: say so, or the start would read as an estimate.
+  return {"updated", false,
+          "none of the " + std::to_string(e.used_frames) +
+              " usable frame(s) ran a search, so the estimate was never updated (last: " +
+              e.last_reason + "; the search window holds " + std::to_string(e.window_frames) +
+              " frames, and a window of 1 frame estimates from a single frame)"};
+}
+
+RuleOutcome EnoughFrames(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
+  if (e.used_frames >= o.min_frames) {
+    return {"enough_frames", true, std::to_string(e.used_frames) + " frames"};
+  }
+  return {"enough_frames", false,
+          std::to_string(e.used_frames) +
+              " usable frame(s) cannot show that the estimate has settled (" +
+              std::to_string(o.min_frames) + " needed)"};
+}
+
+RuleOutcome Acquired(const ConvergenceEvidence& e, const ConvergenceOptions&) {
+  if (!e.acquiring) return {"acquired", true, "acquisition ended"};
+  const int needed = std::max(kMinAgreementFrames, std::min(e.used_frames, e.acquisition_frames));
+  if (e.grid_agreement_frames >= needed) {
+    return {"acquired", true,
+            "the rotation grid agreed with the estimate on all " +
+                std::to_string(e.grid_agreement_frames) + " frames"};
+  }
+  return {"acquired", false,
+          "still acquiring (the rotation grid around the initial calibration has not yet agreed "
+          "with the estimate on a window of " +
+              std::to_string(needed) + " frames" +
+              (e.grid_agreement_frames > 0 ? ", only on " + std::to_string(e.grid_agreement_frames)
+                                           : std::string()) +
+              ")"};
+}
+
+RuleOutcome InsideBounds(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
+  const bool at_time_bound =
+      e.time_offset_estimated &&
+      std::abs(e.time_offset_s) >= e.time_offset_bound_s - o.time_bound_margin_s;
+  const bool at_rotation_bound =
+      e.rotation_moved_deg >= e.rotation_bound_deg - o.rotation_bound_margin_deg;
+  if (!at_time_bound && !at_rotation_bound) {
+    return {"inside_bounds", true, Format("moved %.3f deg", e.rotation_moved_deg)};
+  }
+  std::string text = "the estimate ran to the bound of its " +
+                     std::string(at_time_bound ? "time offset (|δ| = bound)" : "rotation search") +
+                     ": the score has no trustworthy optimum inside the bounds";
+  if (!at_time_bound) text += Format(" (moved %.3f deg)", e.rotation_moved_deg);
+  return {"inside_bounds", false, text};
+}
+
+RuleOutcome Observable(const ConvergenceEvidence& e, const ConvergenceOptions&) {
+  if (e.unobservable_axes.empty()) return {"observable", true, "every axis"};
+  std::string axes;
+  for (const std::string& a : e.unobservable_axes) axes += (axes.empty() ? "" : ", ") + a;
+  return {"observable", false,
+          "not observable in this drive: " + axes +
+              " (held at their start values; the scene does not constrain them)"};
+}
+
+RuleOutcome RotationProfiles(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const RotationAxisProfile& p = e.rotation_profiles[axis];
+    if (std::abs(p.best_deg) > o.max_profile_offset_deg) {
+      return {
+          "rotation_profiles", false,
+          Format("the last frames' score peaks %+.2f deg away on ", p.best_deg) + kAxisNames[axis]};
+    }
+    if (p.ambiguous) {
+      return {"rotation_profiles", false,
+              std::string(kAxisNames[axis]) +
+                  Format(" is ambiguous: a second score peak %+.2f deg away reaches %.0f%% of "
+                         "the best",
+                         p.second_peak_deg, 100 * p.second_peak_ratio)};
+    }
+  }
+  return {"rotation_profiles", true, "each axis peaks at the estimate"};
+}
+
+RuleOutcome TimeOffsetProfileRule(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
+  const TimeOffsetProfile& p = e.time_offset_profile;
+  if (!e.time_offset_estimated || p.scores.empty()) {
+    return {"time_offset_profile", true, "not profiled"};
+  }
+  const double away_s = p.best_s - e.time_offset_s;
+  const std::string text =
+      Format("the last frames' score over δ peaks %+.1f ms away", 1000 * away_s);
+  return {"time_offset_profile", std::abs(away_s) <= o.max_profile_offset_s, text};
+}
+
+RuleOutcome TranslationWithinPrior(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
+  const TranslationMove moved = TranslationMoveBeyond(
+      e.translation_move_m, o.max_translation_move_sigmas, e.prior_sigma_translation_m);
+  if (moved.axis < 0) {
+    return {"translation_within_prior", true,
+            Format("moved at most %.1f cm", 100 * e.translation_move_m.cwiseAbs().maxCoeff())};
+  }
+  return {"translation_within_prior", false,
+          Format("the translation moved %+.1f cm from the start on ", 100 * moved.move_m) +
+              kAxisNames[3 + moved.axis] +
+              Format(", more than %.1f times its prior's %.1f cm: the data overrules the prior (a "
+                     "wrong time offset can show up as a sideways shift); if the start may be "
+                     "that far off, widen the prior (--prior_sigma_translation_m)",
+                     o.max_translation_move_sigmas, 100 * e.prior_sigma_translation_m)};
+}
+
+RuleOutcome Health(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
+  const std::string text = Format("health %.3f ", e.final_health) +
+                           (e.final_health < o.min_final_health ? "<" : ">=") +
+                           Format(" %.2f", o.min_final_health);
+  if (e.final_health >= o.min_final_health) return {"health", true, text};
+  return {"health", false, text + " (the estimate is not a clear optimum of the score)"};
+}
+
+RuleOutcome Settled(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
+  const std::string text =
+      Format("%.3f deg over the last ", e.settle_deg) + std::to_string(o.settle_frames) + " frames";
+  if (e.settle_deg <= o.max_settle_deg) return {"settled", true, text};
+  return {"settled", false, "still moving (" + text + ")"};
+}
+
+// The largest jackknife std a claim may have per rotation axis [deg]: a claim more than 0.5° off
+// is a wrong one, and 0.5° should lie 2.5 σ out.
+constexpr double kMaxJackknifeStdDeg = 0.2;
+
+RuleOutcome Jackknife(const ConvergenceEvidence& e, const ConvergenceOptions&) {
+  if (!e.rotation_jackknife) return {kJackknifeRule, false, "the jackknife was not measured"};
+  const RotationJackknife& j = *e.rotation_jackknife;
+  if (j.frames == 0) return {kJackknifeRule, true, "too few frames to leave a block out"};
+  const std::string spread =
+      Format("the rotation's jackknife std over %.0f frames in %.0f blocks is ", j.frames,
+             j.blocks) +
+      Format("%.3f / %.3f / %.3f deg (roll / pitch / yaw)", j.std_deg.x(), j.std_deg.y(),
+             j.std_deg.z());
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(j.std_deg[axis] < kMaxJackknifeStdDeg)) {
+      return {kJackknifeRule, false,
+              std::string(kAxisNames[axis]) + " is not pinned down by these frames: " + spread +
+                  Format(", over %.2f deg: leaving out a few frames moves the estimate",
+                         kMaxJackknifeStdDeg)};
+    }
+  }
+  return {kJackknifeRule, true, spread};
+}
+
+RuleOutcome SuppressedCheck(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
+  if (!o.check_suppressed_health) return {kSuppressedCheckRule, true, "off"};
+  if (!e.suppressed_check) return {kSuppressedCheckRule, false, "the check was not measured"};
+  const HealthCheckResult& h = *e.suppressed_check;
+  const std::string text = "the check on texture-suppressed maps of the last " +
+                           std::to_string(e.suppressed_check_frames) + " frames says " + h.reason;
+  return {kSuppressedCheckRule, h.decided && h.holds, text};
+}
+
+constexpr Rule kRules[] = {
+    FramesUsed,   Features,   Updated,          EnoughFrames,          Acquired,
+    InsideBounds, Observable, RotationProfiles, TimeOffsetProfileRule, TranslationWithinPrior,
+    Health,       Settled,    Jackknife,        SuppressedCheck};
+
+}  // namespace
+
+std::vector<std::string> ConvergenceRuleNames() {
+  const ConvergenceEvidence evidence;
+  const ConvergenceOptions options;
+  std::vector<std::string> names;
+  for (Rule rule : kRules) names.push_back(rule(evidence, options).name);
+  return names;
+}
+
+Judgement Judge(const ConvergenceEvidence& evidence, const ConvergenceOptions& options) {
+  Judgement judgement;
+  for (Rule rule : kRules) {
+    judgement.rules.push_back(rule(evidence, options));
+    const RuleOutcome& outcome = judgement.rules.back();
+    if (!outcome.passed && judgement.reason.empty()) {
+      judgement.reason = "not converged: " + outcome.detail;
+    }
+  }
+  judgement.converged = judgement.reason.empty();
+  if (judgement.converged) judgement.reason = "converged";
+  return judgement;
+}
+
+ConvergenceEvidence GatherEvidence(const OnlineCalibrator& calibrator,
+                                   const std::vector<FrameReport>& reports,
+                                   const CalibrationState& initial,
+                                   const OnlineCalibratorOptions& online,
+                                   const ConvergenceOptions& options, ConvergenceVerdict* verdict) {
+  ConvergenceEvidence e;
+  verdict->estimate = calibrator.state();
 
   // Aliasing guard over δ and the rotation-axis profiles, on the refinement's frames (the
   // longest window the calibrator keeps: a sharp score's profile over 3 frames is noisy), scored
@@ -53,10 +283,10 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   std::vector<const CalibrationFrame*> profile_frames;
   for (const auto& frame : recent) profile_frames.push_back(frame.get());
   WindowScorer scorer(profile_frames, calibrator.ScoreOptionsInUse());
-  verdict.time_offset_profile =
-      ProfileTimeOffset(&scorer, verdict.estimate, online.time_offset_bound_s, 0.0025);
+  verdict->time_offset_profile =
+      ProfileTimeOffset(&scorer, verdict->estimate, online.time_offset_bound_s, 0.0025);
   for (int axis = 0; axis < 3; ++axis) {
-    verdict.rotation_profiles[axis] = ProfileRotationAxis(&scorer, verdict.estimate, axis);
+    verdict->rotation_profiles[axis] = ProfileRotationAxis(&scorer, verdict->estimate, axis);
   }
 
   // Skipped frames say nothing.
@@ -64,168 +294,126 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   for (const FrameReport& r : reports) {
     if (!r.skipped) used.push_back(&r);
   }
-  verdict.used_frames = static_cast<int>(used.size());
-  verdict.skipped_frames = static_cast<int>(reports.size() - used.size());
+  verdict->used_frames = static_cast<int>(used.size());
+  verdict->skipped_frames = static_cast<int>(reports.size() - used.size());
   const FrameReport empty_report;
   const FrameReport& last = used.empty() ? empty_report : *used.back();
   // The online trajectory's own moves over its last settle_frames updates (frames between
   // updates keep the estimate; a final polish is not a frame): every estimate those updates
   // started from or ended at lies within max_settle_deg of the last. A jump in the first of them
-  // lands on a state the later frames merely keep (a KITTI run jumped 3° to a side peak two
-  // frames before its end).
+  // lands on a state the later frames merely keep.
   std::vector<const FrameReport*> updates;
   for (const FrameReport* r : used) {
     if (r->ran_update()) updates.push_back(r);
   }
   const FrameReport& last_update = updates.empty() ? last : *updates.back();
-  verdict.refine = last_update.refine;
-  double settle_deg = 0;
+  verdict->refine = last_update.refine;
   for (size_t k = updates.size() >= static_cast<size_t>(options.settle_frames)
                       ? updates.size() - options.settle_frames
                       : 0;
        k < updates.size(); ++k) {
     for (const CalibrationState* state : {&updates[k]->before, &updates[k]->after}) {
-      settle_deg = std::max(settle_deg, RotationErrorDeg(state->T_camera_lidar.linear(),
-                                                         last.after.T_camera_lidar.linear()));
+      e.settle_deg = std::max(e.settle_deg, RotationErrorDeg(state->T_camera_lidar.linear(),
+                                                             last.after.T_camera_lidar.linear()));
     }
   }
 
   // Axes the last refinement could not pin down were held: they go back to the start (earlier
   // frames may have moved them before their ambiguity showed).
-  std::string unobservable_text;
   for (int k = 0; k < kNumAxes; ++k) {
     if (k == 6 && !online.refine.estimate_time_offset) continue;
     if (last_update.refine.observable[k]) continue;
-    verdict.unobservable_axes.push_back(kAxisNames[k]);
-    unobservable_text += (unobservable_text.empty() ? "" : ", ") + std::string(kAxisNames[k]);
+    verdict->unobservable_axes.push_back(kAxisNames[k]);
   }
-  const double moved_deg =
-      RotationErrorDeg(verdict.estimate.T_camera_lidar.linear(), initial.T_camera_lidar.linear());
-  const bool at_time_bound = std::abs(verdict.estimate.time_offset_s) >=
-                             online.time_offset_bound_s - options.time_bound_margin_s;
-  const bool at_rotation_bound =
-      moved_deg >= online.search.max_rotation_offset_deg - options.rotation_bound_margin_deg;
-  if (!used.empty() && !verdict.unobservable_axes.empty()) {
-    verdict.estimate = KeepObservableAxes(initial, verdict.estimate, last_update.refine.observable);
-  }
-
-  std::string profile_problem;
-  for (int axis = 0; axis < 3 && profile_problem.empty(); ++axis) {
-    const RotationAxisProfile& p = verdict.rotation_profiles[axis];
-    char text[160] = "";
-    if (std::abs(p.best_deg) > options.max_profile_offset_deg) {
-      std::snprintf(text, sizeof(text), "the last frames' score peaks %+.2f deg away on %s",
-                    p.best_deg, kAxisNames[axis]);
-    } else if (p.ambiguous) {
-      std::snprintf(text, sizeof(text),
-                    "%s is ambiguous: a second score peak %+.2f deg away reaches %.0f%% of the "
-                    "best",
-                    kAxisNames[axis], p.second_peak_deg, 100 * p.second_peak_ratio);
-    }
-    profile_problem = text;
-  }
-  const TimeOffsetProfile& time_profile = verdict.time_offset_profile;
-  if (profile_problem.empty() && online.refine.estimate_time_offset &&
-      !time_profile.scores.empty() &&
-      std::abs(time_profile.best_s - verdict.estimate.time_offset_s) >
-          options.max_profile_offset_s) {
-    char text[160];
-    std::snprintf(text, sizeof(text), "the last frames' score over δ peaks %+.1f ms away",
-                  1000 * (time_profile.best_s - verdict.estimate.time_offset_s));
-    profile_problem = text;
+  e.rotation_moved_deg =
+      RotationErrorDeg(verdict->estimate.T_camera_lidar.linear(), initial.T_camera_lidar.linear());
+  if (!used.empty() && !verdict->unobservable_axes.empty()) {
+    verdict->estimate =
+        KeepObservableAxes(initial, verdict->estimate, last_update.refine.observable);
   }
 
   for (auto it = updates.rbegin();
-       it != updates.rend() && verdict.refinement_spread_updates < options.spread_updates; ++it) {
+       it != updates.rend() && verdict->refinement_spread_updates < options.spread_updates; ++it) {
     if (!(*it)->refine.usable) continue;
     const Eigen::Vector3d d = (*it)->refine.state.T_camera_lidar.translation() -
-                              verdict.estimate.T_camera_lidar.translation();
-    verdict.refinement_spread_m += d.cwiseProduct(d);
-    ++verdict.refinement_spread_updates;
+                              verdict->estimate.T_camera_lidar.translation();
+    verdict->refinement_spread_m += d.cwiseProduct(d);
+    ++verdict->refinement_spread_updates;
   }
-  if (verdict.refinement_spread_updates > 0) {
-    verdict.refinement_spread_m =
-        (verdict.refinement_spread_m / verdict.refinement_spread_updates).cwiseSqrt();
+  if (verdict->refinement_spread_updates > 0) {
+    verdict->refinement_spread_m =
+        (verdict->refinement_spread_m / verdict->refinement_spread_updates).cwiseSqrt();
   }
 
-  const TranslationMove moved =
-      TranslationMoveBeyondPrior(initial, verdict.estimate, options.max_translation_move_sigmas,
-                                 online.refine.prior_sigma_translation_m);
+  e.used_frames = verdict->used_frames;
+  e.skipped_frames = verdict->skipped_frames;
+  e.first_reason = reports.empty() ? "" : reports.front().reason;
+  e.last_points = last.points;
+  e.updates = static_cast<int>(updates.size());
+  e.last_reason = last.reason;
+  e.window_frames = calibrator.options().window_frames;
+  e.acquiring = calibrator.acquiring();
+  e.acquisition_frames = online.refine_frames;
+  e.grid_agreement_frames = last_update.grid_agreement_frames;
+  e.rotation_bound_deg = online.search.max_rotation_offset_deg;
+  e.time_offset_estimated = online.refine.estimate_time_offset;
+  e.time_offset_s = verdict->estimate.time_offset_s;
+  e.time_offset_bound_s = online.time_offset_bound_s;
+  e.unobservable_axes = verdict->unobservable_axes;
+  e.rotation_profiles = verdict->rotation_profiles;
+  e.time_offset_profile = verdict->time_offset_profile;
+  e.translation_move_m =
+      verdict->estimate.T_camera_lidar.translation() - initial.T_camera_lidar.translation();
+  e.prior_sigma_translation_m = online.refine.prior_sigma_translation_m;
+  e.final_health = last.health;
+  return e;
+}
 
-  char text[512];
-  if (used.empty()) {
-    verdict.reason = "not converged: all " + std::to_string(verdict.skipped_frames) +
-                     " frames were skipped" +
-                     (reports.empty() ? "" : " (first reason: " + reports.front().reason + ")");
-  } else if (last.points < options.min_points) {
-    verdict.reason = "not converged: no usable features (" + std::to_string(last.points) +
-                     " LiDAR edge points in the image)";
-  } else if (updates.empty()) {
-    // Not even one update: say so, or the start would read as an estimate.
-    verdict.reason =
-        "not converged: none of the " + std::to_string(verdict.used_frames) +
-        " usable frame(s) ran a search, so the estimate was never updated (last: " + last.reason +
-        "; the search window holds " + std::to_string(calibrator.options().window_frames) +
-        " frames, and a window of 1 frame estimates from a single frame)";
-  } else if (verdict.used_frames < options.min_frames) {
-    verdict.reason = "not converged: " + std::to_string(verdict.used_frames) +
-                     " usable frame(s) cannot show that the estimate has settled (" +
-                     std::to_string(options.min_frames) + " needed)";
-  } else if (calibrator.acquiring()) {
-    verdict.reason =
-        "not converged: still acquiring (the rotation grid around the initial "
-        "calibration has not yet agreed with the estimate on a full window of " +
-        std::to_string(online.refine_frames) + " frames)";
-  } else if (at_time_bound || at_rotation_bound) {
-    std::snprintf(text, sizeof(text),
-                  "not converged: the estimate ran to the bound of its %s: the score has no "
-                  "trustworthy optimum inside the bounds",
-                  at_time_bound ? "time offset (|δ| = bound)" : "rotation search");
-    verdict.reason = text;
-    if (!at_time_bound) verdict.reason += " (moved " + std::to_string(moved_deg) + " deg)";
-  } else if (!verdict.unobservable_axes.empty()) {
-    verdict.reason = "not converged: not observable in this drive: " + unobservable_text +
-                     " (held at their start values; the scene does not constrain them)";
-  } else if (!profile_problem.empty()) {
-    verdict.reason = "not converged: " + profile_problem;
-  } else if (moved.axis >= 0) {
-    std::snprintf(text, sizeof(text),
-                  "not converged: the translation moved %+.1f cm from the start on %s, more than "
-                  "%.1f times its prior's %.1f cm: the data overrules the prior (a wrong time "
-                  "offset can show up as a sideways shift); if the start may be that far off, "
-                  "widen the prior (--prior_sigma_translation_m)",
-                  100 * moved.move_m, kAxisNames[3 + moved.axis],
-                  options.max_translation_move_sigmas,
-                  100 * online.refine.prior_sigma_translation_m);
-    verdict.reason = text;
-  } else if (last.health < options.min_final_health) {
-    std::snprintf(text, sizeof(text),
-                  "not converged: health %.3f < %.2f (the estimate is not a clear optimum of the "
-                  "score)",
-                  last.health, options.min_final_health);
-    verdict.reason = text;
-  } else if (settle_deg > options.max_settle_deg) {
-    std::snprintf(text, sizeof(text),
-                  "not converged: still moving (%.3f deg over the last %d frames)", settle_deg,
-                  options.settle_frames);
-    verdict.reason = text;
-  } else {
-    verdict.converged = true;
-    verdict.reason = "converged";
+ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
+                                    const std::vector<FrameReport>& reports,
+                                    const CalibrationState& initial,
+                                    const OnlineCalibratorOptions& online,
+                                    const ConvergenceOptions& options) {
+  ConvergenceVerdict verdict;
+  ConvergenceEvidence evidence =
+      GatherEvidence(calibrator, reports, initial, online, options, &verdict);
+  Judgement judgement = Judge(evidence, options);
+  // The jackknife (a refinement per frame) and the check on texture-suppressed maps (a health
+  // score per window) are measured only when the rules before them pass.
+  auto only_these_fail = [&](std::initializer_list<const char*> names) {
+    for (const RuleOutcome& rule : judgement.rules) {
+      if (rule.passed) continue;
+      bool listed = false;
+      for (const char* name : names) listed = listed || rule.name == name;
+      if (!listed) return false;
+    }
+    return true;
+  };
+  if (only_these_fail({kJackknifeRule, kSuppressedCheckRule})) {
+    const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
+    std::vector<const CalibrationFrame*> frames;
+    for (const auto& frame : recent) frames.push_back(frame.get());
+    evidence.rotation_jackknife = JackknifeRotation(frames, verdict.estimate, initial,
+                                                    calibrator.RefineOptionsInUse(/*polish=*/true),
+                                                    SharedSweepFrames(frames));
+    verdict.rotation_jackknife = *evidence.rotation_jackknife;
+    judgement = Judge(evidence, options);
   }
-  if (!verdict.converged || !options.check_suppressed_health) return verdict;
-
-  // The independent check on the texture-suppressed maps of the last frames.
-  const size_t keep = std::min<size_t>(recent.size(), options.check_frames);
-  const std::vector<std::shared_ptr<const CalibrationFrame>> frames(recent.end() - keep,
-                                                                    recent.end());
-  verdict.health_check = CheckCalibrationHealth(frames, verdict.estimate, options.health_check);
-  verdict.health_checked = true;
-  if (!verdict.health_check.decided || !verdict.health_check.holds) {
-    verdict.converged = false;
-    verdict.reason = "not converged: the check on texture-suppressed maps of the last " +
-                     std::to_string(keep) + " frames says " + verdict.health_check.reason;
+  if (options.check_suppressed_health && only_these_fail({kSuppressedCheckRule})) {
+    const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
+    const size_t keep = std::min<size_t>(recent.size(), options.check_frames);
+    const std::vector<std::shared_ptr<const CalibrationFrame>> frames(recent.end() - keep,
+                                                                      recent.end());
+    evidence.suppressed_check =
+        CheckCalibrationHealth(frames, verdict.estimate, options.health_check);
+    evidence.suppressed_check_frames = static_cast<int>(keep);
+    verdict.health_check = *evidence.suppressed_check;
+    verdict.health_checked = true;
+    judgement = Judge(evidence, options);
   }
+  verdict.converged = judgement.converged;
+  verdict.reason = judgement.reason;
+  verdict.rules = judgement.rules;
   return verdict;
 }
 
@@ -238,6 +426,13 @@ ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool ti
     reported.has_std[k] = refine.covariance_ok;
     reported.std_dev[k] = refine.std_dev[k];
     reported.observable[k] = refine.observable[k];
+  }
+  // A rotation axis: at least the jackknife's std over the window's frames.
+  if (verdict.rotation_jackknife.frames > 0) {
+    for (int k = 0; k < 3; ++k) {
+      if (!reported.has_std[k]) continue;
+      reported.std_dev[k] = std::max(reported.std_dev[k], verdict.rotation_jackknife.std_deg[k]);
+    }
   }
   // A translation axis: at least the window refinements' spread about the estimate, and not
   // observable beyond the threshold.

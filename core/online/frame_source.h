@@ -16,7 +16,7 @@ struct FrameSourceOptions {
   ImageFeatureOptions image;
   LidarFeatureOptions lidar;
   LocalMapOptions local_map;
-  // Dense foliage traps the plain IDT score degrees from the truth (method.md §10): score on
+  // Dense foliage traps the plain IDT score degrees from the truth (docs/method.md §10): score on
   // texture-suppressed maps.
   bool suppress_texture = true;  ///< score maps are the texture-suppressed IDTs
   // With suppress_texture: the finest score map is the band-pass IDT (not clipped at zero, see

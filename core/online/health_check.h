@@ -11,22 +11,20 @@
 
 namespace stcalib {
 
-// Does a stored calibration still hold (method.md §7)? Frames are taken in windows; each window
-// gets the health score at the calibration (share of the 728 neighbours at ±1° / ±5 cm that score
-// worse) and the best neighbour's score gain. A calibrated pair has health near 1 and no
+// Does a stored calibration still hold (docs/method.md §7)? Frames are taken in windows; each
+// window gets the health score at the calibration (share of the 728 neighbours at ±1° / ±5 cm that
+// score worse) and the best neighbour's score gain. A calibrated pair has health near 1 and no
 // neighbour much better; a pair 1° off has a clearly better neighbour.
 struct HealthCheckOptions {
   int window_frames = 3;
   double rotation_step_deg = 1.0;    ///< neighbour offset on roll, pitch, yaw [deg]
   double translation_step_m = 0.05;  ///< neighbour offset on x, y, z [m]
-  // The calibration holds when the mean health over the windows is at least this. Measured on
-  // the shared KITTI frames (texture-suppressed maps, windows of 3): 0.96 with KITTI's
-  // calibration, 0.76–0.90 at 0.5° off, 0.37–0.73 at 1° off.
+  // The calibration holds when the mean health over the windows is at least this (between a
+  // calibrated pair's and one 1° off). Measured: docs/tuning.md#min-health
   double min_health = 0.85;
   // Health is a share and saturates along directions the scene barely constrains; the best
   // neighbour's score gain does not: the calibration is off when, on average over the windows,
-  // some neighbour scores more than this share better. Shared KITTI frames: 0.066 with KITTI's
-  // calibration, 0.11–0.34 at 1° off about random axes (0.5° off: 0.075–0.23).
+  // some neighbour scores more than this share better. Measured: docs/tuning.md#max-neighbour-gain
   double max_neighbour_gain = 0.09;
   double point_margin = 0.02;      ///< points kept inside the image shrunk by this share
   int min_points_per_window = 60;  ///< fewer LiDAR edge points in the image: window skipped

@@ -72,6 +72,31 @@ double TrackingRotationShare(double gain, double rotation_rad, double max_lag_ra
 }
 
 namespace {
+constexpr EnumNames<Phase, 4> kPhaseNames = {{{Phase::kFilling, "filling"},
+                                              {Phase::kAcquiring, "acquiring"},
+                                              {Phase::kTracking, "tracking"},
+                                              {Phase::kLost, "lost"}}};
+}  // namespace
+
+std::string PhaseName(Phase phase) { return EnumName(kPhaseNames, phase); }
+
+Phase NextPhase(Phase current, const PhaseInputs& in) {
+  const Phase acquired = in.health >= in.lost_health ? Phase::kTracking : Phase::kLost;
+  switch (current) {
+    case Phase::kFilling:
+      if (in.window_size < in.window_frames) return Phase::kFilling;
+      if (!in.acquisition) return acquired;
+      return in.grid_agreed ? acquired : Phase::kAcquiring;
+    case Phase::kAcquiring:
+      return in.grid_agreed ? acquired : Phase::kAcquiring;
+    case Phase::kTracking:
+    case Phase::kLost:
+      return acquired;
+  }
+  return current;
+}
+
+namespace {
 constexpr EnumNames<OnlineCalibratorOptions::Folds, 3> kFoldsNames = {
     {{OnlineCalibratorOptions::Folds::kKeep, "keep"},
      {OnlineCalibratorOptions::Folds::kDrop, "drop"},
@@ -154,6 +179,7 @@ FrameReport OnlineCalibrator::SkipFrame(int frame, const std::string& why) const
   FrameReport report;
   report.frame = frame;
   report.acquiring = acquiring();
+  report.phase = phase_;
   report.before = report.after = state_;
   report.skipped = true;
   report.reason = "frame skipped: " + why + "; estimate kept";
@@ -189,8 +215,8 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   // end, and the folds stay. Once dropped they stay out, of a lost estimate's grid too. The
   // first frame without them that updates does so at once and by a full step (`refit`): the
   // estimate was acquired with the folds, and its translation carries their bias.
-  if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && !acquiring_ &&
-      !folds_dropped_) {
+  if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && Acquires() &&
+      !acquiring() && !folds_dropped_) {
     folds_dropped_ = true;
     refit_pending_ = true;
   }
@@ -220,6 +246,7 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   if (report.points < 30) {
     report.reason = "too few LiDAR edge points in the image (" + std::to_string(report.points) +
                     "): estimate kept";
+    report.phase = phase_;
     return report;
   }
   WindowScorer scorer(frames, ScoreOptionsInUse());
@@ -230,13 +257,14 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   WindowScorer* health_scorer = HealthScorer(frames, &scorer, &own_health_scorer);
   report.health_before = HealthScore(health_scorer, state_, kHealthRotationDeg, kHealthTranslationM,
                                      nullptr, &health_cache_);
-  if (options_.wait_for_full_window && static_cast<int>(frames.size()) < options_.window_frames) {
+  const int window_size = static_cast<int>(frames.size());
+  UpdatePhase(window_size, report.health_before);
+  if (options_.wait_for_full_window && phase_ == Phase::kFilling) {
     return KeepEstimate(report, "window filling (" + std::to_string(frames.size()) + " of " +
                                     std::to_string(options_.window_frames) +
                                     " frames): estimate kept");
   }
-  const bool tracking = !acquiring() && report.health_before >= options_.lost_health &&
-                        static_cast<int>(frames.size()) >= options_.window_frames;
+  const bool tracking = phase_ == Phase::kTracking;
   if (tracking && !update_now && !refit &&
       ++frames_since_update_ < options_.tracking_update_every) {
     RememberIfHealthy(report.health_before, frames.size());
@@ -268,7 +296,20 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   state_ = report.after;
   MeasureEstimate(&scorer, health_scorer, report.accepted, &report);
   RememberIfHealthy(report.health, frames.size());
+  UpdatePhase(window_size, report.health);
+  report.phase = phase_;
   return report;
+}
+
+void OnlineCalibrator::UpdatePhase(int window_size, double health, bool grid_agreed) {
+  PhaseInputs in;
+  in.window_size = window_size;
+  in.window_frames = options_.window_frames;
+  in.acquisition = Acquires();
+  in.grid_agreed = grid_agreed;
+  in.health = health;
+  in.lost_health = options_.lost_health;
+  phase_ = NextPhase(phase_, in);
 }
 
 FrameReport OnlineCalibrator::Polish() {
@@ -350,6 +391,7 @@ void OnlineCalibrator::RememberIfHealthy(double health, size_t window_size) {
 
 FrameReport OnlineCalibrator::KeepEstimate(FrameReport report, const std::string& reason) {
   report.reason = reason;
+  report.phase = phase_;
   report.score_after = report.score_before;
   report.gray_rate_after = report.gray_rate_before;
   report.health = last_health_ = report.health_before;
@@ -413,9 +455,11 @@ void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
       grid_evaluations += static_cast<int>(profile.offsets_s.size()) + 1;
     }
   }
+  if (grid_agrees) report->grid_agreement_frames = static_cast<int>(long_scorer->num_frames());
   if (was_acquiring && grid_agrees &&
       static_cast<int>(long_scorer->num_frames()) >= options_.refine_frames) {
-    acquiring_ = false;
+    UpdatePhase(static_cast<int>(scorer->num_frames()), report->health_before,
+                /*grid_agreed=*/true);
   }
   report->search = AdaptiveGridSearch(scorer, search_start, anchor_, *search_options);
   report->search.evaluations += grid_evaluations;

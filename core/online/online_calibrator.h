@@ -19,9 +19,9 @@ struct OnlineCalibratorOptions {
   // The defaults are set for real streets (KITTI drive 0013, tree-lined) and serve simulated
   // drives as well; `stcalib calibrate`'s flags take their defaults from here.
   int window_frames = 3;  ///< sliding window of frames searched together
-  // A few frames can prefer a side peak 3.5° off (drive 0013, frames 10-16): refine on 20. (An
-  // acquisition ends only when the grid agrees with the estimate on a full refinement window:
-  // drives shorter than about refine_frames + 5 frames want fewer.)
+  // Many frames: a few can prefer a side peak degrees off. An acquisition ends only when the grid
+  // agrees with the estimate on a full refinement window: drives shorter than about
+  // refine_frames + 5 frames want fewer. Measured: docs/tuning.md#refine-frames
   int refine_frames = 20;  ///< the refinement uses this many latest frames
   // The refinement reads the points of each frame's latest refine_map_sweeps sweeps only (its
   // own first; 0 = the whole local map, FrameSourceOptions::local_map). The search and the score
@@ -33,59 +33,40 @@ struct OnlineCalibratorOptions {
   AdaptiveGridSearchOptions search;
   RefineOptions refine;
   // Horizontal LiDAR edges are the less faithful ones (foliage tops scatter; the tops of cars
-  // seen from above show a roof sliver in the image): at w = 0.5 the first 8 frames of drive 0013
-  // sat on a side peak 4-6° off, at w = 0.2 they are 0.2-0.7° off by frame 5; over all 30 frames
-  // the score peaks at the same roll and yaw for any w in [0, 1].
-  double horizontal_weight = 0.2;  ///< w of method.md §6, for the score and the refinement
+  // seen from above show a roof sliver in the image), so they weigh less than vertical ones.
+  // Measured: docs/tuning.md#horizontal-weight
+  double horizontal_weight = 0.2;  ///< w of docs/method.md §6, for the score and the refinement
   // w once the folds are dropped (Folds::kDropWhenTracking, from the first frame after the
   // acquisition): in every window, refinement and health from then on, and in the polish. The
   // folds are the horizontal edges that bias (a top's corner seen from above); without them the
   // rest carry roll, which vertical edges (trunks, poles) constrain only through their height.
-  // Measured against 0.2 (scripts/sweep; 40-frame simulated drives, seeds 1-12): KITTI within
-  // 0.2° of its calibration on 13 of 16 starts (12), max 0.216° (0.261°), mean 0.176° (0.171°);
-  // the 40-frame drives at a mean 0.096° (0.110°), 8 of 12 within 0.1° (5); the 20-frame ones
-  // unchanged; other cameras' 40-frame drives (hd720 seeds 1, 3; kitti_1003 seeds 2, 4) 0.255°,
-  // 0.133°, 0.045°, 0.063° (0.273°, 0.126°, 0.053°, 0.095°); KITTI's 2° disturbance at frame 15
-  // (seeds 1-3) ends 0.127°, 0.130°, 0.205° (0.187°, 0.147°, 0.277°). With refine_frames 10:
-  // simulated mean 0.162° (0.153°), KITTI 16 of 16 converged (15). 0.5: KITTI 13 of 16 but one
-  // δ 10.6 ms off; 0.8: 5 of 16 KITTI starts refused (one 5.9° off).
+  // Measured: docs/tuning.md#tracking-horizontal-weight
   double tracking_horizontal_weight = 0.35;
   double time_offset_bound_s = 0.15;  ///< |δ| bound for search and refinement [s]
-  // Health (method.md §7) below this at the current estimate, or a window not yet full, means
+  // Health (docs/method.md §7) below this at the current estimate, or a window not yet full, means
   // the estimate may be far off: the search runs coarse-to-fine from the widest map instead of
   // on the finest one only.
   double lost_health = 0.9;
   // The polish moves δ with the forward translation only when its refinement puts the forward
   // translation's std under this [m] (and δ's under refine.observable_time_s). The covariance
   // treats the edge residuals as independent, which neighbouring points of one edge are not, so
-  // the std is optimistic. With the translation prior's 5 cm, a std of 4.1-4.8 cm is the prior
-  // with little from the data; at 2.0-3.3 cm the data carries the pair. 30 simulated 20-frame
-  // drives from ±5 cm (scripts/sweep's 14 and seeds 15-30): of the 7 windows at 2.0-3.3 cm, freed,
-  // 5 ended within 2.3 cm of the truth and 2 at 4.3 and 7.0 cm, where held all 7 ended at the
-  // start's 5 cm. (An earlier version of the refinement saw windows at 2.1-2.9 cm end 2-4 std
-  // off, so the threshold was 2 cm.)
+  // the std is optimistic; near the translation prior's σ it is the prior's, with little from the
+  // data. Measured: docs/tuning.md#polish-forward-std
   double polish_forward_std_m = 0.035;
   // The refinement's robust loss once acquired (tracking, refit and polish); refine.loss and
   // refine.loss_scale_px while acquiring. About a quarter of the LiDAR edge points have no image
   // edge near them even at the truth (an outline between two surfaces of one grey, a trunk
   // against a dark wall); under refine's Cauchy loss each still pulls towards whatever edge lies
-  // within the distance map's basin, and as these pulls do not cancel they turn the estimate (a
-  // simulated drive with exact navigation, no moving objects and δ = 0 ended 0.15° off in roll,
-  // its matched points alone at the truth within 0.01°). A redescending loss (Tukey) gives a
-  // point farther than its scale from every edge no pull at all. It needs a start within a few
-  // pixels, which the acquisition gives; while acquiring it slows the pull from ±2°. Measured
-  // (scripts/sweep; Cauchy 1 px throughout in brackets): at 5 px simulated seeds 1-14 mean
-  // 0.103° (0.106°), within 0.1° on 6 (6); all 30 seeds 0.099° (0.101°); KITTI mean 0.151°
-  // (0.190°), within 0.2° on 15 of 16 (10); the fifth frame unchanged. At 3 px: simulated 0.097°,
-  // 8 of 14, KITTI 0.160°, 14 of 16, but seed 22 0.127° (0.062°; 0.092° at 5 px). In the polish
-  // only (3 px): KITTI 0.179°, 11 of 16. Tukey (3 px) from the first frame: simulated 0.084°, 9 of
-  // 14, but the fifth frame under 0.5° on 12 of 14 (14) and KITTI's within 0.3° on 5 of 16 (10).
+  // within the distance map's basin, and as these pulls do not cancel they turn the estimate. A
+  // redescending loss (Tukey) gives a point farther than its scale from every edge no pull at
+  // all. It needs a start within a few pixels, which the acquisition gives; while acquiring it
+  // slows the pull from ±2°. Measured: docs/tuning.md#acquired-loss
   RefineOptions::Loss acquired_loss = RefineOptions::Loss::kTukey;
   double acquired_loss_scale_px = 5.0;      ///< [px]
   bool acquired_loss_when_tracking = true;  ///< also in tracking updates (else polish only)
   bool coarse_until_window_full = true;
   // No update before the search window holds window_frames frames: one frame's score can have
-  // its best optimum degrees away (a simulated drive, frame 0 alone: 5.9° off from a 3.5° start).
+  // its best optimum degrees away. Measured: docs/tuning.md#wait-for-full-window
   bool wait_for_full_window = true;
   // Points are kept when they project inside the image shrunk by this share of its size on
   // each side (negative: grown), at the estimate when their frame arrives. A band-pass score is
@@ -100,15 +81,16 @@ struct OnlineCalibratorOptions {
   double lost_grid_step_deg = 0.5;
   // Acquisition: from the start, the grid runs on every frame (not only when lost) until, on a
   // full refinement window, its best point agrees with the estimate within one grid step (on
-  // each axis; √3 steps in all). A few
-  // frames can have their global optimum far off; the frames a full window holds do not.
+  // each axis; √3 steps in all). A few frames can have their global optimum far off; the frames a
+  // full window holds do not.
   bool acquire_with_grid = true;
   // While acquiring, after the grid, δ is scanned over its whole bound at the grid's rotation and
   // the search starts from the best δ (unless the profile has a second peak nearly as high).
   bool acquire_time_offset = true;
   // The scan's δ is taken only when the estimate's δ scores less than this share of the way from
   // the profile's lowest score to its best: where the two nearly tie, the local search decides
-  // (on KITTI the scan's best wanders by 5-10 ms while the rotation is still off).
+  // (the scan's best wanders while the rotation is still off).
+  // Measured: docs/tuning.md#acquire-time-offset-keep-ratio
   double acquire_time_offset_keep_ratio = 0.9;
   // When lost, also search from the last healthy estimate and offer the result as a candidate.
   bool search_from_last_healthy = true;
@@ -120,27 +102,17 @@ struct OnlineCalibratorOptions {
   // ... but the rotation never lags an accepted update's estimate by more than this
   // (TrackingRotationShare): a move beyond a single window's scatter is taken as a correction,
   // but for this remainder (0 = off: tracking_gain alone) [deg]. With the gain alone a start
-  // that the first search left 1.3° off closes 30 % of the gap per frame (KITTI from 1.5°, seed
-  // 3: 0.87° at the fifth frame; 0.49° at 0.3°). Measured on the shared KITTI frames (16 starts,
-  // 1-3°; fifth frame mean / final mean / within 0.2°): off 0.362° / 0.151° / 15; 0.2° 0.314 /
-  // 0.167 / 13; 0.25° 0.299 / 0.167 / 13; 0.3° 0.305 / 0.148 / 16; 0.4° 0.336 / 0.158 / 13;
-  // 0.5° 0.372 / 0.148 / 14. On simulated drives it rarely acts (3 of scripts/sweep's 30
-  // changed; a start the first search left 3.5° off, seed 33, went from 1.7° to 0.2° at the
-  // fifth frame; 40-frame drives unchanged). At 0.3° a KITTI start with δ 50 ms off and no δ
-  // scan (Cli.KittiWrongTimeOffsetIsRefused) ends 0.26° and 12.3 cm off sideways (camera x,
-  // reported std 1.1 cm) with δ 22 ms off; ConvergenceOptions::max_translation_move_sigmas
-  // refuses it (the gain alone left it refused by its roll profile, peaking 0.5° away).
+  // that the first search left far off closes only tracking_gain of the gap per update.
+  // Measured: docs/tuning.md#tracking-max-lag
   double tracking_max_lag_deg = 0.3;
   // Candidates are judged by their window score (the score map: a wide basin, but its peak can sit
   // a few tenths of a degree from the refinement's optimum). The refined rotation, with the chosen
   // candidate's translation and δ, is taken in place of the best-scoring candidate when it scores
   // within this share of the best (candidates and the current estimate): the refinement knows
   // where on the peak, the score only where the peak is. Beyond the share the refinement has
-  // followed a few frames' misfits off the peak (a simulated drive's refined estimate scored 12 %
-  // and 26 % under the estimate there; on KITTI the rotations taken score a median 3 % under). Not
-  // on a coarse window while acquiring (its refinement starts from a search still finding the
-  // peak). 0 = the best score wins. KITTI from 1-3 deg starts, fifth frame: 0.19-1.07 deg,
-  // median 0.43, with 0; 0.14-0.87 deg, median 0.26, with 0.1.
+  // followed a few frames' misfits off the peak. Not on a coarse window while acquiring (its
+  // refinement starts from a search still finding the peak). 0 = the best score wins.
+  // Measured: docs/tuning.md#refined-score-tolerance
   double refined_score_tolerance = 0.1;
   // While tracking (acquisition over, a full window, health at least lost_health), the search
   // and refinement run on every n-th frame only; the frames between join the window and have
@@ -153,38 +125,21 @@ struct OnlineCalibratorOptions {
   // window, or dropped once acquired (from the first frame after the acquisition: the grid, the δ
   // scan and the updates that acquire read them; tracking, refinement, polish and the verdict's
   // profiles do not). Whatever the choice, the health (a frame's, the lost test's, the verdict's
-  // final health) reads every point: see HealthWindow. (kDrop was measured below before that.)
-  // Folds bias the vertical translation (2-5 cm on simulated drives) and KITTI's roll, but
-  // the first frames' search needs them: kDropWhenTracking, the default, keeps them for the
-  // acquisition only. The frame they are first dropped on updates at once and by a full step
-  // (the acquired translation carries the folds' bias: without that step, a 16-frame simulated
-  // drive with refine_frames 10 ended 0.35° from the truth, its polish refining the rotation
-  // into that bias; with it 0.10°, kKeep 0.14°). Measured against kKeep:
-  //  - scripts/sweep (30 runs): KITTI ends within 0.2° of its calibration on 12 of 16 starts
-  //    (kKeep 2; mean 0.171° against 0.262°), fifth frame alike (10 of 16); the 20-frame
-  //    simulated drives are unchanged (their acquisition ends on their last frame).
-  //  - 40-frame simulated drives, seeds 1-12 (δ +30 ms, 6 movers, ±2°/±5 cm): rotation mean
-  //    0.110° (kKeep 0.125°), within 3 cm on 11 of 12 (4). Fold-free tracking lets roll drift on
-  //    some (seed 1: 0.255°, kKeep 0.071°; its turn, frames 16-27, pulls roll 0.3-0.6° off even
-  //    from the truth and with the folds kept), kKeep's vertical bias others (seed 12: 0.302°
-  //    and 5.7 cm, here 0.112° and 2.4 cm). Other cameras, 40 frames: hd720 seeds 1 and 3 0.273°
-  //    and 0.126° (kKeep 0.125°, 0.123°), kitti_1003 seeds 2 and 4 0.053° and 0.095° (0.142°,
-  //    0.094°); within 3 cm on 4 of 4 (2).
-  //  - With refine_frames 10 (scripts/sweep): simulated rotation mean 0.153° (kKeep 0.197°), 6
-  //    of 14 within 0.1° (4); KITTI 0 of 16 within 0.2° either way, 15 of 16 converged (16).
-  //  - kDrop: KITTI's fifth frame within 0.3° on 4 of 16, and one start claimed 0.52° and 8 cm.
-  //  - Ending the acquisition on fewer frames than refine_frames (14, 10), so that 20-frame
-  //    drives also track without folds, made both worse (simulated within 0.1° on 6 of 14).
+  // final health) reads every point: see HealthWindow.
+  // Folds bias the vertical translation and KITTI's roll, but the first frames' search needs
+  // them: kDropWhenTracking, the default, keeps them for the acquisition only. The frame they are
+  // first dropped on updates at once and by a full step (the acquired translation carries the
+  // folds' bias, into which a polish would otherwise refine the rotation).
   // kDropWhenTracking without the grid's acquisition (acquire_with_grid off, lost_grid_deg 0)
   // keeps them: there is no acquisition to end. Once dropped, they stay out of every later
-  // window, a lost estimate's grid and search included.
+  // window, a lost estimate's grid and search included. Measured: docs/tuning.md#folds
   enum class Folds { kKeep, kDrop, kDropWhenTracking };
   Folds folds = Folds::kDropWhenTracking;
 
   // Whether the search reads the frames' coarse score levels (their pyramid): only without the
   // rotation grid (lost_grid_deg = 0), where a lost or filling window searches coarse to fine.
   // With the grid every search starts on the finest map, and a frame source can leave the
-  // pyramid out (about 20 ms of blurs per KITTI frame).
+  // pyramid out (its blurs cost time on every frame; measured: docs/tuning.md#reads-coarse-levels).
   bool ReadsCoarseLevels() const { return lost_grid_deg <= 0; }
   Status Validate() const;
 };
@@ -205,7 +160,7 @@ std::string FoldsChoices();
 // polish's first). While tracking, the forward translation is held by its prior, so a tracking
 // refinement's δ std is conditional on that prior: on a straight road at constant speed δ is then
 // only as right as the start's forward translation (δ error = forward error ÷ speed), however
-// small its std (KITTI: 0.45 ms held, 3.8 ms with the forward translation free).
+// small its std (measured: docs/tuning.md#time-forward-pair).
 struct TimeForwardPair {
   bool measured = false;         ///< the solve estimated δ and gave a covariance
   bool separated = false;        ///< both observable, and the pair moved with the window's data
@@ -216,18 +171,44 @@ struct TimeForwardPair {
   Eigen::Vector3d forward_camera = Eigen::Vector3d::UnitZ();
 };
 
+// The calibrator's phase (docs/method.md §7). Filling: the search window is not full yet.
+// Acquiring: a rotation grid around the start runs on every update until it agrees with the
+// estimate on a full refinement window. Tracking: acquired and healthy; updates every
+// tracking_update_every frames, each moving part of the way. Lost: acquired, but the health at
+// the estimate fell under lost_health; searches coarse-to-fine until healthy again.
+enum class Phase { kFilling, kAcquiring, kTracking, kLost };
+std::string PhaseName(Phase phase);  ///< filling | acquiring | tracking | lost
+
+// What a phase transition reads.
+struct PhaseInputs {
+  int window_size = 0;       ///< frames in the search window now
+  int window_frames = 0;     ///< the search window's length
+  bool acquisition = true;   ///< the calibrator acquires with a rotation grid at all
+  bool grid_agreed = false;  ///< a grid agreed with the estimate on a full refinement window
+  double health = 0;         ///< at the estimate on the latest window
+  double lost_health = 0;    ///< under it an acquired estimate is lost
+};
+// The phase after `current` given `in`. Filling ends when the window is full (into acquiring,
+// or straight to tracking/lost without an acquisition); acquiring ends only when the grid
+// agreed; tracking and lost follow the health. No phase goes back to filling or acquiring.
+Phase NextPhase(Phase current, const PhaseInputs& in);
+
 struct FrameReport {
   int frame = 0;
+  Phase phase = Phase::kFilling;  ///< the calibrator's phase after this frame
   CalibrationState before, after;
   bool accepted = false;
   bool skipped = false;  ///< the frame was refused (bad data): nothing changed, see `reason`
   std::string reason;    ///< why the update was (not) taken
   ScoreValue score_before, score_after;              ///< on the finest score map
   double gray_rate_before = 0, gray_rate_after = 0;  ///< on the plain IDT
-  double health_before = 0;                          ///< method.md §7, at `before`
-  double health = 0;                                 ///< method.md §7, at `after`
+  double health_before = 0;                          ///< docs/method.md §7, at `before`
+  double health = 0;                                 ///< docs/method.md §7, at `after`
   bool coarse_search = false;
   bool acquiring = false;  ///< the calibrator was still acquiring when the frame arrived
+  // Frames of this update's rotation grid when its best rotation agreed with the estimate (within
+  // one grid step); 0 when it did not or no grid ran.
+  int grid_agreement_frames = 0;
   SearchResult search;
   RefineResult refine;
   TimeForwardPair time_forward;  ///< set by the polish only
@@ -243,7 +224,7 @@ struct FrameReport {
 CalibrationState KeepObservableAxes(const CalibrationState& old, const CalibrationState& candidate,
                                     const std::array<bool, kNumAxes>& observable);
 
-// Online calibration (method.md §7): frames in time order; per frame (once acquired, per
+// Online calibration (docs/method.md §7): frames in time order; per frame (once acquired, per
 // tracking_update_every frames while healthy) a search step and a refine over the window; an update
 // is taken only when the window score does not get worse and the axes it moves are observable (an
 // unobservable axis keeps its value); |δ| stays within its bound. It only sequences the stages; the
@@ -271,22 +252,22 @@ class OnlineCalibrator {
   // Still acquiring (OnlineCalibratorOptions::acquire_with_grid with a grid): the rotation grid
   // has not yet agreed with the estimate on a full refinement window.
   bool acquiring() const {
-    return options_.acquire_with_grid && options_.lost_grid_deg > 0 && acquiring_;
+    return Acquires() && (phase_ == Phase::kFilling || phase_ == Phase::kAcquiring);
   }
+  Phase phase() const { return phase_; }
   // The final step of a run: refines the rotation, δ and the translation along the direction of
   // travel over the latest refine_frames frames from the estimate (the lateral and vertical
   // translation held). While tracking, the estimate moves only tracking_gain of the way per update
   // and each move is judged on the score map, whose peak can sit a few tenths of a degree from the
-  // refinement's optimum: the search is for finding the peak, the refinement for where on it
-  // (KITTI from 1-3 deg starts: 0.25-0.63 deg without, 0.24-0.32 with). While tracking, the
-  // forward translation is held at the start's and δ absorbs its error (δ error = forward error ÷
-  // speed); over the whole window, speed changes and turns can separate the two. The forward
-  // translation and δ move together when both are observable (forward std under
-  // polish_forward_std_m, δ std under refine.observable_time_s); otherwise both stay and the
-  // rotation is refined again with them held (KITTI's 30 frames do not separate them: 4.2 cm). The
-  // lateral and vertical translation stay because edges pin them down only to a few cm (a free one
-  // moved 4 cm on KITTI). Nothing changes while acquiring, when the last frame's health is below
-  // lost_health, or when the refinement fails or leaves the bounds; the report says what happened.
+  // refinement's optimum: the search is for finding the peak, the refinement for where on it.
+  // While tracking, the forward translation is held at the start's and δ absorbs its error (δ
+  // error = forward error ÷ speed); over the whole window, speed changes and turns can separate
+  // the two. The forward translation and δ move together when both are observable (forward std
+  // under polish_forward_std_m, δ std under refine.observable_time_s); otherwise both stay and the
+  // rotation is refined again with them held. The lateral and vertical translation stay because
+  // edges pin them down only to a few cm. Nothing changes while acquiring, when the last frame's
+  // health is below lost_health, or when the refinement fails or leaves the bounds; the report
+  // says what happened. Measured: docs/tuning.md#polish
   FrameReport Polish();
   // Replaces the estimate (the paper's disturbance protocol); the bounds stay where they were.
   // The next frame updates whatever tracking_update_every says.
@@ -299,8 +280,8 @@ class OnlineCalibrator {
   // The same frames with every point, folds included: what the health reads (a frame's, the lost
   // test's and so the verdict's) whatever OnlineCalibratorOptions::folds says. Folds bias where
   // the optimum sits by a few cm and tenths of a degree, but they sharpen it: without them, the
-  // last windows of KITTI's 30 frames scored health 0.82-0.95 at estimates 0.1-0.2° from its
-  // calibration (0.95-0.99 with them), under the verdict's 0.9, and 3 of 16 starts were refused.
+  // health of estimates close to the calibration can fall under the verdict's threshold
+  // (ConvergenceOptions::min_final_health). Measured: docs/tuning.md#health-window
   std::vector<const CalibrationFrame*> HealthWindow() const;
   // Every frame the calibrator keeps (the latest max(window_frames, refine_frames), what a
   // refinement on the latest frame reads among them), oldest first, as it reads them now
@@ -363,10 +344,15 @@ class OnlineCalibrator {
   // The estimate becomes the last healthy one when `health` reaches lost_health on a full window.
   void RememberIfHealthy(double health, size_t window_size);
 
+  // Whether there is an acquisition at all (acquire_with_grid with a grid).
+  bool Acquires() const { return options_.acquire_with_grid && options_.lost_grid_deg > 0; }
+  // phase_ after this frame's window size, health and whether a grid agreed.
+  void UpdatePhase(int window_size, double health, bool grid_agreed = false);
+
   OnlineCalibratorOptions options_;
   CalibrationState state_;
-  CalibrationState anchor_;     ///< the initial calibration: the search's bounds are around it
-  bool acquiring_ = true;       ///< see OnlineCalibratorOptions::acquire_with_grid
+  CalibrationState anchor_;  ///< the initial calibration: the search's bounds are around it
+  Phase phase_ = Phase::kFilling;
   bool folds_dropped_ = false;  ///< OnlineCalibratorOptions::Folds::kDropWhenTracking in effect
   // options_ with horizontal_weight at tracking_horizontal_weight, shared into score and refine
   // by WithSharedSettings: what the calibrator reads once the folds are dropped.

@@ -12,7 +12,7 @@
 namespace stcalib {
 
 // Joint refinement of rotation, translation and time offset over a window of frames with Ceres
-// (method.md §6): one EdgeAlignmentCost per frame (a residual per LiDAR edge point, each under
+// (docs/method.md §6): one EdgeAlignmentCost per frame (a residual per LiDAR edge point, each under
 // the robust loss), plus a weak CalibrationPriorCost towards the search result.
 // ceres::Covariance then gives per-axis standard deviations; an axis is observable when its std
 // is under a threshold.
@@ -20,15 +20,15 @@ struct RefineOptions {
   enum class Loss { kHuber, kCauchy, kTukey };
   Loss loss = Loss::kCauchy;
   double loss_scale_px = 1.0;      ///< robust-loss scale [px]
-  double horizontal_weight = 0.5;  ///< w of method.md §6
+  double horizontal_weight = 0.5;  ///< w of docs/method.md §6
   // Weak priors: rotation towards the search result, translation and δ towards the mount (the
   // initial calibration); they hold only what the data leaves free (δ against the forward
-  // translation on a straight road, method.md §10).
+  // translation on a straight road, docs/method.md §10).
   double prior_sigma_rotation_deg = 2.0;  ///< [deg]
   // Lateral and vertical (with Translation::kAlongTravel, forward too) [m].
   double prior_sigma_translation_m = 0.05;
   // Along the direction of travel the translation is held firmly (per point, i.e. the sigma is
-  // scaled by √N): there data cannot tell it from δ on a straight road (method.md §10).
+  // scaled by √N): there data cannot tell it from δ on a straight road (docs/method.md §10).
   double prior_sigma_forward_m = 0.05;
   double prior_sigma_time_s = 0.03;   ///< [s]
   double time_offset_bound_s = 0.15;  ///< |δ| bound [s]
@@ -40,14 +40,9 @@ struct RefineOptions {
   // (speed changes, turns) and the covariance says where it does not.
   enum class Translation { kFree, kAlongTravel, kHeld };
   Translation translation = Translation::kFree;
-  // The local map's earlier sweeps were merged with the poses at the LiDAR stamps, which are off
-  // by δ: place each merged point at the start's δ (CalibrationFrame::offset_rates) and hold it
-  // there during the solve. Left at the stamps, the map biased δ and the forward translation
-  // along their ridge in proportion to δ (simulated drives started at the truth, δ = 60 ms: the
-  // polish moved forward +3.5 to +11 cm; placed, under 1 cm). Moving with δ inside the solve
-  // gave +1 to +5 cm: its derivative, from the oxts rates, is no information on δ to go by. Off
-  // while tracking: there a placement at a δ still far off holds δ there (KITTI from δ0 =
-  // +50 ms: δ stayed at +33 ms, not converged, where the stamps' map ends at +9.5 ms, converged).
+  // Hold the local map's earlier sweeps (merged at the LiDAR stamps, off by δ) at the start's δ
+  // (CalibrationFrame::offset_rates), else they bias δ and the forward translation; off while
+  // tracking, where it holds a δ still far off. Measured: docs/tuning.md#place-at-time-offset
   bool place_at_time_offset = false;
   int max_points_per_frame = 300;
   int max_iterations = 12;

@@ -18,7 +18,8 @@ struct FrameImageAndMotion {
   int index = 0;             ///< frame of the drive
   double e0_s = 0;           ///< LiDAR stamp − camera stamp [s]; the gap is e = e0 + δ
   double camera_time_s = 0;  ///< image stamp on the drive's clock [s] (frames must advance)
-  LidarTwist twist;          ///< LiDAR body twist at the image time (motion model, method.md §3)
+  LidarTwist twist;          ///< LiDAR body twist at the image time (motion model,
+                             ///< docs/method.md §3)
   CameraModel camera;        ///< size read from the image
   ImageFeatures image;       ///< distance_raw_px for overlays
   // Maps per edge kind, indexed by EdgeKind (0 vertical, 1 horizontal): with oriented maps a
@@ -27,7 +28,7 @@ struct FrameImageAndMotion {
   // Score maps, coarsest first, finest last (IDTs of growing sharpness).
   std::array<std::vector<cv::Mat>, 2> score_maps;
   // Plain (not suppressed) IDT: its mean at the projected points is the gray rate that picks
-  // the search's step sizes (method.md §6).
+  // the search's step sizes (docs/method.md §6).
   std::array<cv::Mat, 2> gray_map;
   // Smoothed, capped distance maps for the refinement's bicubic residuals [px].
   std::array<cv::Mat, 2> distance_px;

@@ -9,11 +9,11 @@
 
 namespace stcalib {
 
-// Score of a calibration (method.md §6): over projected LiDAR edge points, the score map at the
-// projected pixel (bilinear), horizontal points weighted w and vertical ones 1 − w. The gray
+// Score of a calibration (docs/method.md §6): over projected LiDAR edge points, the score map at
+// the projected pixel (bilinear), horizontal points weighted w and vertical ones 1 − w. The gray
 // rate is score / 255 / (weighted number of points): the mean map value, 0..1.
 struct ScoreOptions {
-  double horizontal_weight = 0.5;  ///< w of method.md §6
+  double horizontal_weight = 0.5;  ///< w of docs/method.md §6
   int max_points_per_frame = 600;  ///< evenly thinned for speed; 0 = all
 };
 
@@ -76,7 +76,7 @@ class WindowScorer {
   std::vector<std::vector<Eigen::Vector3d>> moved_;
 };
 
-// The 728 neighbour directions of the 6-DoF grid (method.md §6), each component in {−1, 0, 1}
+// The 728 neighbour directions of the 6-DoF grid (docs/method.md §6), each component in {−1, 0, 1}
 // (rotation first, then translation), in a fixed order; with `translation` false the 26 that
 // move the rotation only.
 const std::vector<Eigen::Matrix<double, 6, 1>>& NeighbourDirections(bool translation);
@@ -109,7 +109,7 @@ struct HealthSetting {
 };
 using HealthScoreCache = FrameScoreCache<HealthSetting>;  // per frame: centre, 728 neighbours
 
-// Health score (method.md §7): the share of the 728 grid neighbours at ±`rotation_deg` /
+// Health score (docs/method.md §7): the share of the 728 grid neighbours at ±`rotation_deg` /
 // ±`translation_m` that score worse than `state` on the finest map. Window scores are the sums
 // of the frames' scores in frame order, so a result from `cache` (optional) is identical to one
 // without it.

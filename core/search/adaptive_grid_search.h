@@ -11,7 +11,7 @@
 
 namespace stcalib {
 
-// Adaptive step-size grid search (method.md §6). From the current estimate all 3⁶ − 1 = 728
+// Adaptive step-size grid search (docs/method.md §6). From the current estimate all 3⁶ − 1 = 728
 // neighbours (±step on each of roll, pitch, yaw, x, y, z) are scored; the step pair is the large
 // one (α1 rotation, α2 translation) while the gray rate is below γ and the small one (α3, α4)
 // above it. When a neighbour is better the search keeps moving in that direction while the score
@@ -37,9 +37,9 @@ struct AdaptiveGridSearchOptions {
   // Bounds around `anchor` (the mount / initial calibration): the search never leaves them.
   double max_rotation_offset_deg = 6.0;
   double max_translation_offset_m = 0.15;
-  // Translation prior (method.md §10: δ and the forward translation lie on a ridge): the search
-  // maximises score − translation_prior_weight·255·W·(|t − t_anchor| / σ)², W the weight sum,
-  // i.e. a deviation of σ costs `translation_prior_weight` of gray rate; δ likewise.
+  // Translation prior (docs/method.md §10: δ and the forward translation lie on a ridge): the
+  // search maximises score − translation_prior_weight·255·W·(|t − t_anchor| / σ)², W the weight
+  // sum, i.e. a deviation of σ costs `translation_prior_weight` of gray rate; δ likewise.
   double translation_prior_sigma_m = 0.05;
   double translation_prior_weight = 0.01;
   // The same for δ around the anchor's δ0 [s]: periodic structure gives δ far peaks (§10).

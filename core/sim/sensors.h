@@ -62,13 +62,10 @@ cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, c
 
 // The error of a fused GPS/INS navigation solution such as KITTI's OXTS RT3003 (RTK): a smooth
 // drift of a few centimetres and a few 1e-4 rad that wanders over tens of seconds, plus a small
-// white part per packet. The drift is a sum of sinusoids with random periods and phases, so it
-// can be evaluated at any time alone (each frame is simulated alone) and its rate is exact: the
-// written velocities carry the position drift's rate, as a Kalman filter's output would, and a
-// slow drift of their own. That is what KITTI's shared packets show: the difference between a
-// position step and the velocities' step over it has a high-frequency part of 1.3-4.2 mm per axis
-// and is otherwise slow (lag-1 autocorrelation +0.68..+0.89, σ 3-14 mm per 0.1 s), and the
-// velocities integrated over the 30 frames (34 m) end 0.46 m from the positions.
+// white part per packet. The drift is a sum of sinusoids with random periods and phases, so it can
+// be evaluated at any time alone (each frame is simulated alone) and its rate is exact: the written
+// velocities carry the position drift's rate, as a Kalman filter's output would, and a slow drift
+// of their own, as KITTI's shared packets show (measured: docs/tuning.md#navigation-error).
 struct NavigationErrorOptions {
   double position_drift_m = 0.02;    ///< σ of the slow position error, per axis [m]
   double angle_drift_rad = 2e-4;     ///< σ of the slow roll, pitch and yaw error [rad]

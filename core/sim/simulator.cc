@@ -252,7 +252,7 @@ FrameTiming Simulator::Timing(int frame) const {
   out.oxts_time_s = out.camera_time_s - 0.004 + oxts_jitter(clock_rng);
   auto stamp = [&](double t) { return start_stamp_ns_ + SecondsToNs(t); };
   out.camera_stamp_ns = stamp(out.camera_time_s);
-  // LiDAR stamps carry −δ: a frame stamped t_l was captured at t_l + δ (method.md §2).
+  // LiDAR stamps carry −δ: a frame stamped t_l was captured at t_l + δ (docs/method.md §2).
   out.lidar_stamp_ns = stamp(out.lidar_mid_time_s - options_.time_offset_s);
   out.lidar_start_stamp_ns = out.lidar_stamp_ns - SecondsToNs(0.5 * SweepDuration());
   out.lidar_end_stamp_ns = out.lidar_stamp_ns + SecondsToNs(0.5 * SweepDuration());

@@ -100,11 +100,11 @@ class Simulator {
   StampNs start_stamp_ns_ = 0;
 };
 
-// Writes a drive in KITTI raw layout (method.md §9) under out_dir/<date>/: the three calibration
-// files, ground_truth.json, and <date>_drive_0001_sync/ with image_02, velodyne_points (+ labels)
-// and oxts. Everything goes to a hidden temporary folder first and is renamed into place at the
-// end, so an interrupted run never leaves a drive that looks complete. `progress` (optional) is
-// called after each frame.
+// Writes a drive in KITTI raw layout (docs/method.md §9) under out_dir/<date>/: the three
+// calibration files, ground_truth.json, and <date>_drive_0001_sync/ with image_02, velodyne_points
+// (+ labels) and oxts. Everything goes to a hidden temporary folder first and is renamed into place
+// at the end, so an interrupted run never leaves a drive that looks complete. `progress` (optional)
+// is called after each frame.
 Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& out_dir,
                            std::string* drive_dir,
                            const std::function<void(int done, int total)>& progress = nullptr);

@@ -6,7 +6,7 @@
 
 namespace stcalib {
 
-// The quantity stcalib estimates (method.md §1–2).
+// The quantity stcalib estimates (docs/method.md §1–2).
 struct CalibrationState {
   // Te = T_C<-L: LiDAR frame to unrectified camera 0, as R/T of calib_velo_to_cam.txt.
   Rigid3d T_camera_lidar = Rigid3d::Identity();

@@ -4,8 +4,8 @@
 
 namespace stcalib {
 
-// The rectified colour camera image_02 (method.md §1): a point p_camera in unrectified camera 0
-// projects as u ~ P_rect_02 · [R_rect_00 · p_camera; 1].
+// The rectified colour camera image_02 (docs/method.md §1): a point p_camera in unrectified camera
+// 0 projects as u ~ P_rect_02 · [R_rect_00 · p_camera; 1].
 struct CameraModel {
   Eigen::Matrix3d R_rect_00 = Eigen::Matrix3d::Identity();
   Eigen::Matrix<double, 3, 4> P_rect_02 = Eigen::Matrix<double, 3, 4>::Zero();

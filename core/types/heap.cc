@@ -11,8 +11,8 @@ namespace stcalib {
 bool RetainFreedHeapMemory() {
 #if defined(__GLIBC__)
   // 256 MiB keeps every per-frame block on the heap; an older glibc refuses a fixed threshold
-  // above its dynamic threshold's 32 MiB ceiling, which is the fallback (on KITTI's tracking
-  // frames about as fast: BM_WholeFrame/3 63.3-65.1 against 61.7-65.1 ms, run alternately).
+  // above its dynamic threshold's 32 MiB ceiling, which is the fallback (about as fast on KITTI's
+  // tracking frames; measured: docs/tuning.md#retain-freed-heap-memory).
   constexpr int kMmapThresholdBytes = 256 << 20;
   constexpr int kFallbackMmapThresholdBytes = 32 << 20;
   constexpr int kTrimThresholdBytes = 1 << 30;

@@ -8,10 +8,9 @@ namespace stcalib {
 // copies, an image's float maps), and they are freed when the frame leaves the window. By
 // default glibc serves such blocks by mmap and unmaps them on free, or trims the top of the heap
 // once 128 KiB are free, so the next frame touches fresh pages and pays a page fault for every
-// 4 KiB: on a 2-core virtual machine 8-11 % of a tracking frame was spent in the kernel's page
-// fault handler. Blocks up to 256 MiB now come from the heap (32 MiB where an older glibc caps
-// the threshold there), and the heap is trimmed only when 1 GiB is free; a run's resident memory
-// grows by about 2 % (685 → 698 MB on KITTI).
+// 4 KiB. Blocks up to 256 MiB now come from the heap (32 MiB where an older glibc caps the
+// threshold there), and the heap is trimmed only when 1 GiB is free, at the cost of a slightly
+// larger resident memory. Measured: docs/tuning.md#retain-freed-heap-memory
 //
 // A process-wide setting: the `stcalib` CLI and the benchmarks call it first thing; a program
 // that embeds the library decides for itself. Returns false when the allocator refused (not
