@@ -747,6 +747,16 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     EXPECT_TRUE(polish.refine.observable[0] && polish.refine.observable[1] &&
                 polish.refine.observable[2]);
     polished.push_back(calibrator.state());
+    // The polish never lowers the window's score: its rotation is taken only where the score
+    // agrees (the pair is held here, so the alternative is the online estimate itself).
+    std::vector<const CalibrationFrame*> window;
+    for (const auto& f : calibrator.RecentFrames()) window.push_back(f.get());
+    WindowScorer scorer(window, calibrator.ScoreOptionsInUse());
+    EXPECT_GE(scorer.Evaluate(calibrator.state(), -1).score,
+              scorer.Evaluate(before_polish, -1).score);
+    EXPECT_EQ(polish.reason.find("rotation kept") != std::string::npos,
+              RotationErrorDeg(calibrator.state().T_camera_lidar.linear(),
+                               before_polish.T_camera_lidar.linear()) == 0.0);
     EXPECT_EQ(calibrator.state().T_camera_lidar.translation(),
               before_polish.T_camera_lidar.translation());
     EXPECT_EQ(calibrator.state().time_offset_s, before_polish.time_offset_s);

@@ -358,7 +358,22 @@ FrameReport OnlineCalibrator::Polish() {
   std::array<bool, kNumAxes> move = report.refine.observable;
   for (int k = 3; k < kNumAxes; ++k) move[k] = pair_observable;
   if (!refine_options.estimate_time_offset) move[6] = false;
-  const CalibrationState polished = KeepObservableAxes(state_, report.refine.state, move);
+  CalibrationState polished = KeepObservableAxes(state_, report.refine.state, move);
+  // The refined rotation is taken only where the window's score agrees that it is no worse than
+  // the online one (with the same translation and δ): the refinement's cost and the score weigh
+  // the frames' misfits differently, and a move only one of them prefers is as likely to be
+  // wrong as right (docs/tuning.md#polish-rotation).
+  bool rotation_kept = false;
+  {
+    CalibrationState online_rotation = polished;
+    online_rotation.T_camera_lidar.linear() = state_.T_camera_lidar.linear();
+    WindowScorer window_scorer(LatestFrames(options_.refine_frames), ScoreOptionsInUse());
+    if (window_scorer.Evaluate(polished, -1).score <
+        window_scorer.Evaluate(online_rotation, -1).score) {
+      polished = online_rotation;
+      rotation_kept = true;
+    }
+  }
   if (!WithinBounds(polished, anchor_, options_.search)) {
     report.reason = "polish: the refined estimate leaves the bounds";
     return report;
@@ -373,7 +388,8 @@ FrameReport OnlineCalibrator::Polish() {
                   pair_observable ? "refined" : "held", 100 * pair.forward_std_m,
                   1000 * pair.std_dev[6], pair.time_forward_correlation);
   }
-  report.reason = "polish: refined over " + std::to_string(frames.size()) + " frames" + pair_text;
+  report.reason = "polish: refined over " + std::to_string(frames.size()) + " frames" + pair_text +
+                  (rotation_kept ? "; rotation kept (the window's score prefers it)" : "");
   // On the search window (the health on HealthWindow), like a frame's.
   const std::vector<const CalibrationFrame*> window = SearchWindow();
   WindowScorer scorer(window, ScoreOptionsInUse());
