@@ -48,7 +48,7 @@ struct CalibrateOutcome {
 
 CalibrateJob CalibrateJobFromFlags();
 // What is wrong with the calibration flags that CalibrateJobFromFlags reads by name (--loss,
-// --acquired_loss, --lidar_folds, --detector); empty when nothing is.
+// --lidar_folds, --detector); empty when nothing is.
 std::string CalibrateFlagsError();
 // What δ rests on: "window" (the polish separated it from the forward translation),
 // "forward_translation_prior" (it did not, or did not run), "start" (δ not estimated).

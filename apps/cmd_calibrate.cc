@@ -101,59 +101,33 @@ CalibrateJob CalibrateJobFromFlags() {
   OnlineCalibratorOptions& o = job.online;
   o.window_frames = FLAGS_window_frames;
   o.time_offset_bound_s = FLAGS_time_offset_bound_s;
-  o.lost_health = FLAGS_lost_health;
-  o.coarse_until_window_full = FLAGS_coarse_until_window_full;
-  o.wait_for_full_window = FLAGS_wait_for_full_window;
-  o.search_from_last_healthy = FLAGS_search_from_last_healthy;
   o.lost_grid_deg = FLAGS_lost_grid_deg;
-  o.lost_grid_step_deg = FLAGS_lost_grid_step_deg;
   o.acquire_time_offset = FLAGS_acquire_time_offset;
   o.point_margin = FLAGS_point_margin;
   ParseFolds(FLAGS_lidar_folds, &o.folds);
   o.horizontal_weight = FLAGS_horizontal_weight;
-  o.tracking_horizontal_weight = FLAGS_tracking_horizontal_weight;
-  o.search.alpha1_rotation_deg = FLAGS_alpha1_rotation_deg;
-  o.search.alpha2_translation_m = FLAGS_alpha2_translation_m;
-  o.search.alpha3_rotation_deg = FLAGS_alpha3_rotation_deg;
-  o.search.alpha4_translation_m = FLAGS_alpha4_translation_m;
-  o.search.gamma = FLAGS_gamma;
   o.search.search_time_offset = FLAGS_estimate_time_offset;
   o.search.translation_prior_sigma_m = FLAGS_prior_sigma_translation_m;
   o.search.time_offset_prior_sigma_s = FLAGS_prior_sigma_time_s;
   o.refine.estimate_time_offset = FLAGS_estimate_time_offset;
   ParseLoss(FLAGS_loss, &o.refine.loss);  // CalibrateFlagsError checked both names
-  ParseLoss(FLAGS_acquired_loss, &o.acquired_loss);
-  o.acquired_loss_scale_px = FLAGS_acquired_loss_scale_px;
-  o.acquired_loss_when_tracking = FLAGS_acquired_loss_when_tracking;
-  o.refine.loss_scale_px = FLAGS_loss_scale_px;
-  o.refine.prior_sigma_rotation_deg = FLAGS_prior_sigma_rotation_deg;
   o.refine.prior_sigma_translation_m = FLAGS_prior_sigma_translation_m;
-  o.refine.prior_sigma_forward_m = FLAGS_prior_sigma_forward_m;
   o.refine.prior_sigma_time_s = FLAGS_prior_sigma_time_s;
-  o.refine.max_points_per_frame = FLAGS_max_points_per_frame;
-  o.refine.max_iterations = FLAGS_refine_max_iterations;
   o.refine_frames = FLAGS_refine_frames;
-  o.refine_map_sweeps = FLAGS_refine_map_sweeps;
   o.tracking_gain = FLAGS_tracking_gain;
   o.tracking_max_lag_deg = FLAGS_tracking_max_lag_deg;
   o.refined_score_tolerance = FLAGS_refined_score_tolerance;
   o.tracking_update_every = FLAGS_tracking_update_every;
   o.refine.observable_rotation_deg = FLAGS_observable_rotation_deg;
-  o.refine.observable_translation_m = FLAGS_observable_translation_m;
-  o.refine.observable_time_s = FLAGS_observable_time_s;
-  o.polish_forward_std_m = FLAGS_polish_forward_std_m;
   job.source.local_map.sweeps = FLAGS_local_map_sweeps;
   job.source.local_map.use_ndt = FLAGS_use_ndt;
   job.source.lidar.remove_dynamic = FLAGS_remove_dynamic;
   job.source.suppress_texture = FLAGS_suppress_texture;
   job.source.bandpass_score = FLAGS_bandpass_score;
-  job.source.oriented_maps = FLAGS_oriented_maps;
   // CalibrateFlagsError has checked the detector's name.
   CHECK(ImageOptionsFromFlags(&job.source.image).ok()) << FLAGS_detector;
-  job.convergence.check_suppressed_health = FLAGS_check_suppressed_health;
   job.convergence.health_check.min_health = FLAGS_min_health;
-  job.convergence.max_translation_move_sigmas = FLAGS_max_translation_move_sigmas;
-  job.convergence.min_final_health = FLAGS_lost_health;  // lost is never converged
+  job.convergence.min_final_health = o.lost_health;  // lost is never converged
   return job;
 }
 
@@ -540,8 +514,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
 }
 
 std::string CalibrateFlagsError() {
-  for (const auto& [name, value] :
-       {std::pair{"--loss", &FLAGS_loss}, std::pair{"--acquired_loss", &FLAGS_acquired_loss}}) {
+  for (const auto& [name, value] : {std::pair{"--loss", &FLAGS_loss}}) {
     RefineOptions::Loss loss;
     if (!ParseLoss(*value, &loss)) return std::string(name) + " must be " + LossChoices();
   }

@@ -63,40 +63,13 @@ DEFINE_bool(estimate_time_offset, kOnline.refine.estimate_time_offset,
             "calibrate: estimate δ (false: keep δ0)");
 DEFINE_string(loss, LossName(kOnline.refine.loss).c_str(),
               "calibrate: robust loss while acquiring, huber | cauchy | tukey");
-// Refinement from drive 0013's calibration over frames 0-29: 0.27 deg at 1 px, 0.35 at 3 px.
-DEFINE_double(loss_scale_px, kOnline.refine.loss_scale_px, "calibrate: robust-loss scale [px]");
 DEFINE_double(horizontal_weight, kOnline.horizontal_weight,
               "calibrate: weight w of horizontal edges (vertical: 1 - w)");
-DEFINE_double(tracking_horizontal_weight, kOnline.tracking_horizontal_weight,
-              "calibrate: w once the folds are dropped (--lidar_folds=drop_when_tracking, after "
-              "the acquisition)");
-DEFINE_double(alpha1_rotation_deg, kOnline.search.alpha1_rotation_deg,
-              "search: large rotation step [deg]");
-DEFINE_double(alpha2_translation_m, kOnline.search.alpha2_translation_m,
-              "search: large translation step [m]");
-DEFINE_double(alpha3_rotation_deg, kOnline.search.alpha3_rotation_deg,
-              "search: small rotation step [deg]");
-DEFINE_double(alpha4_translation_m, kOnline.search.alpha4_translation_m,
-              "search: small translation step [m]");
-DEFINE_double(gamma, kOnline.search.gamma,
-              "search: gray-rate threshold between the large and the small step pair");
-DEFINE_double(lost_health, kOnline.lost_health,
-              "calibrate: below this health the search goes coarse-to-fine");
-DEFINE_double(prior_sigma_rotation_deg, kOnline.refine.prior_sigma_rotation_deg,
-              "refine: weak rotation prior [deg]");
 DEFINE_double(prior_sigma_translation_m, kOnline.refine.prior_sigma_translation_m,
               "search and refine: translation prior around the start [m]");
-DEFINE_double(prior_sigma_forward_m, kOnline.refine.prior_sigma_forward_m,
-              "refine: translation prior along the direction of travel, per point [m]");
 DEFINE_double(prior_sigma_time_s, kOnline.refine.prior_sigma_time_s,
               "search and refine: time-offset prior around δ0 [s]");
 DEFINE_int32(refine_frames, kOnline.refine_frames, "calibrate: latest frames in the refinement");
-DEFINE_int32(refine_map_sweeps, kOnline.refine_map_sweeps,
-             "calibrate: the refinement reads each local map's latest N sweeps (0 = all)");
-DEFINE_int32(refine_max_iterations, kOnline.refine.max_iterations,
-             "refine: at most this many Ceres iterations per refinement");
-DEFINE_int32(max_points_per_frame, kOnline.refine.max_points_per_frame,
-             "refine: LiDAR edge points used per frame");
 DEFINE_double(tracking_gain, kOnline.tracking_gain,
               "calibrate: share of an accepted update taken while tracking");
 DEFINE_double(tracking_max_lag_deg, kOnline.tracking_max_lag_deg,
@@ -109,27 +82,8 @@ DEFINE_int32(tracking_update_every, kOnline.tracking_update_every,
              "calibrate: while tracking, search and refine on every n-th frame (1 = every frame)");
 DEFINE_double(observable_rotation_deg, kOnline.refine.observable_rotation_deg,
               "refine: a rotation axis is observable below this std [deg]");
-DEFINE_double(observable_translation_m, kOnline.refine.observable_translation_m,
-              "refine: a translation axis is observable below this std [m]");
-DEFINE_double(observable_time_s, kOnline.refine.observable_time_s,
-              "refine: δ is observable below this std [s]");
-DEFINE_string(acquired_loss, LossName(kOnline.acquired_loss).c_str(),
-              "calibrate: robust loss once acquired (tracking and polish), huber | cauchy | tukey");
-DEFINE_double(acquired_loss_scale_px, kOnline.acquired_loss_scale_px,
-              "calibrate: scale of --acquired_loss [px]");
-DEFINE_bool(acquired_loss_when_tracking, kOnline.acquired_loss_when_tracking,
-            "calibrate: --acquired_loss in tracking updates too (else in the polish only)");
-DEFINE_double(polish_forward_std_m, kOnline.polish_forward_std_m,
-              "calibrate: the polish moves δ with the forward translation only below this "
-              "forward std [m]");
 DEFINE_double(min_health, kConvergence.health_check.min_health,
               "check, calibrate: the calibration holds when the mean health reaches this");
-DEFINE_double(max_translation_move_sigmas, kConvergence.max_translation_move_sigmas,
-              "calibrate: converged only when the translation ends within this many "
-              "--prior_sigma_translation_m of the start on each axis (0 = no limit)");
-DEFINE_bool(check_suppressed_health, kConvergence.check_suppressed_health,
-            "calibrate: converged also needs the health check on texture-suppressed maps of the "
-            "last 9 frames to hold");
 DEFINE_int32(local_map_sweeps, kSource.local_map.sweeps,
              "calibrate: sweeps merged into the local map");
 DEFINE_bool(remove_dynamic, kSource.lidar.remove_dynamic,
@@ -138,9 +92,6 @@ DEFINE_bool(use_ndt, kSource.local_map.use_ndt,
             "calibrate: refine the local map's poses with PCL NDT");
 DEFINE_bool(suppress_texture, kSource.suppress_texture,
             "calibrate: score on texture-suppressed maps");
-DEFINE_bool(
-    oriented_maps, kSource.oriented_maps,
-    "calibrate: vertical/horizontal LiDAR edges read maps of vertical/horizontal image edges");
 DEFINE_int32(disturb_frame, -1,
              "calibrate: at this frame add a rotation disturbance (test protocol)");
 DEFINE_double(disturb_rot_deg, 2.0,
@@ -149,17 +100,10 @@ DEFINE_double(disturb_rot_deg, 2.0,
 DEFINE_int32(lidar_decimation, 2, "eval-temporal: keep every n-th sweep");
 DEFINE_double(lidar_delay_s, 0.1, "eval-temporal: the kept sweeps arrive this late [s]");
 DEFINE_double(eval_max_range_m, 120.0, "eval-temporal: points beyond this range are left out [m]");
-DEFINE_bool(coarse_until_window_full, kOnline.coarse_until_window_full,
-            "calibrate: coarse-to-fine search on every frame until the search window is full");
-DEFINE_bool(wait_for_full_window, kOnline.wait_for_full_window,
-            "calibrate: no update before the search window holds --window_frames frames");
-DEFINE_bool(search_from_last_healthy, kOnline.search_from_last_healthy,
-            "calibrate: when lost, also search from the last healthy estimate");
 DEFINE_bool(polish, true,
             "calibrate: refine the final estimate over the refinement's frames from itself");
 DEFINE_double(lost_grid_deg, kOnline.lost_grid_deg,
               "calibrate: when lost, first an exhaustive rotation grid of +-this [deg] (0 = none)");
-DEFINE_double(lost_grid_step_deg, kOnline.lost_grid_step_deg, "calibrate: step of that grid [deg]");
 DEFINE_bool(acquire_time_offset, kOnline.acquire_time_offset,
             "calibrate: while acquiring, scan δ over its whole bound after the rotation grid");
 DEFINE_bool(bandpass_score, kSource.bandpass_score,

@@ -19,24 +19,36 @@ struct Subcommand {
   const char* synopsis;
   const char* summary;
   int (*run)();
+  // The options that matter (at most 20), listed by --help with their defaults and meanings;
+  // --helpfull lists every flag.
+  std::vector<const char*> options;
 };
 
 const std::vector<Subcommand>& Subcommands() {
   static const std::vector<Subcommand> kSubcommands = {
-      {"info", "--drive=DRIVE_DIR [--calib_dir=DIR]",
+      {"info",
+       "--drive=DRIVE_DIR [--calib_dir=DIR]",
        "frames, sensor rates, stamp gaps, points per frame and the calibration of a drive",
-       &RunInfo},
-      {"project", "--drive=DRIVE_DIR --frame=I --out=FILE.png [--calib_dir=DIR]",
-       "LiDAR points of one frame projected on its image, coloured by depth", &RunProject},
+       &RunInfo,
+       {"drive", "calib_dir"}},
+      {"project",
+       "--drive=DRIVE_DIR --frame=I --out=FILE.png [--calib_dir=DIR]",
+       "LiDAR points of one frame projected on its image, coloured by depth",
+       &RunProject,
+       {"drive", "frame", "out", "calib_dir"}},
       {"simulate",
        "--out=DIR [--frames=N (40)] [--seed=S (1)] [--time_offset_s=X (0)] "
        "[--dynamic_objects=K (6)] [--scene=urban|poles|open] [--lidar_hz=10] "
        "[--camera=kitti|kitti_1003|hd720] [--oxts_white_position_m=0.001] [--oxts_error_scale=1]",
        "a KITTI-raw drive with exact ground truth (extrinsic, time offset, motion, labels)",
-       &RunSimulate},
-      {"features", "--drive=DRIVE_DIR --frame=I --out=DIR [--calib_dir=DIR]",
+       &RunSimulate,
+       {"out", "frames", "seed", "time_offset_s", "dynamic_objects", "scene", "camera", "lidar_hz",
+        "oxts_white_position_m", "oxts_error_scale"}},
+      {"features",
+       "--drive=DRIVE_DIR --frame=I --out=DIR [--calib_dir=DIR]",
        "image edge mask and IDT, LiDAR edge points (vertical, horizontal, dynamic) as PNGs",
-       &RunFeatures},
+       &RunFeatures,
+       {"drive", "frame", "out", "calib_dir", "detector"}},
       {"calibrate",
        "--drive=DRIVE_DIR [--calib_dir=DIR] [--init_calib=FILE] [--perturb_rot_deg=D] "
        "[--perturb_trans_m=M] [--perturb_time_s=S] [--seed=S] [--first_frame=I] [--num_frames=N] "
@@ -44,12 +56,33 @@ const std::vector<Subcommand>& Subcommands() {
        "online calibration of rotation, translation and time offset; with --out writes the "
        "estimate, result.json, per_frame.csv and pictures, without it prints the estimate; exit 0 "
        "only when converged",
-       &RunCalibrate},
+       &RunCalibrate,
+       {"drive",
+        "calib_dir",
+        "init_calib",
+        "out",
+        "first_frame",
+        "num_frames",
+        "perturb_rot_deg",
+        "perturb_trans_m",
+        "perturb_time_s",
+        "seed",
+        "estimate_time_offset",
+        "time_offset_bound_s",
+        "prior_sigma_translation_m",
+        "prior_sigma_time_s",
+        "window_frames",
+        "refine_frames",
+        "local_map_sweeps",
+        "detector",
+        "remove_dynamic",
+        "polish"}},
       {"eval-temporal",
        "--drive=DRIVE_DIR [--lidar_decimation=2] [--lidar_delay_s=0.1] [--out=DIR]",
        "the paper's Table I: ApproximateTime pairing vs the motion model (filter_cloud, "
        "infer_cloud, infer_cloud_interpolation); prints the tables, --out also writes them",
-       &RunEvalTemporal},
+       &RunEvalTemporal,
+       {"drive", "lidar_decimation", "lidar_delay_s", "eval_max_range_m", "out"}},
       {"check",
        "--drive=DRIVE_DIR [--calib_dir=DIR] [--init_calib=FILE] [--perturb_rot_deg=D] "
        "[--perturb_trans_m=M] [--perturb_time_s=S (added to the stored δ)] [--seed=S] "
@@ -59,11 +92,15 @@ const std::vector<Subcommand>& Subcommands() {
        "health score of the stored calibration (δ from time_offset.txt beside it) per window of "
        "frames; exit 0 when it holds, 1 "
        "when it is off, with the evidence",
-       &RunCheck},
-      {"demo", "[--out=DIR] [--seed=S]",
+       &RunCheck,
+       {"drive", "calib_dir", "init_calib", "perturb_rot_deg", "perturb_trans_m", "perturb_time_s",
+        "seed", "first_frame", "num_frames", "out", "min_health"}},
+      {"demo",
+       "[--out=DIR] [--seed=S]",
        "simulate a drive (true time offset +30 ms), calibrate it from +-2 deg / +-5 cm, print "
        "truth, start, estimate and error",
-       &RunDemo},
+       &RunDemo,
+       {"out", "seed"}},
   };
   return kSubcommands;
 }
@@ -101,7 +138,16 @@ int Main(int argc, char** argv) {
   for (int i = 2; i < argc; ++i) {
     if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
       std::cout << "Usage: stcalib " << command->name << " " << command->synopsis << "\n  "
-                << command->summary << "\n";
+                << command->summary << "\n\nOptions:\n";
+      for (const char* option : command->options) {
+        gflags::CommandLineFlagInfo info;
+        CHECK(gflags::GetCommandLineFlagInfo(option, &info)) << option;
+        std::cout << "  --" << info.name
+                  << " (default: " << (info.default_value.empty() ? "none" : info.default_value)
+                  << ")\n      " << info.description << "\n";
+      }
+      std::cout << "\nEvery other flag, with its default: stcalib " << command->name
+                << " --helpfull\n";
       return kExitOk;
     }
   }

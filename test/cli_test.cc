@@ -56,6 +56,32 @@ TEST(Cli, HelpListsSubcommands) {
   EXPECT_THAT(unknown.output, HasSubstr("unknown subcommand 'frobnicate'"));
 }
 
+// `stcalib SUBCOMMAND --help` lists the options that matter, at most 20, each with its default;
+// --helpfull keeps every flag (the tuning ones too).
+TEST(Cli, SubcommandHelpListsAtMostTwentyOptions) {
+  for (const char* command :
+       {"info", "project", "simulate", "features", "calibrate", "eval-temporal", "check", "demo"}) {
+    const RunResult r = RunStcalib(std::string(command) + " --help");
+    EXPECT_EQ(r.exit_code, 0) << command;
+    int options = 0;
+    std::istringstream lines(r.output);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.rfind("  --", 0) == 0) {
+        ++options;
+        EXPECT_THAT(line, HasSubstr("(default: ")) << command;
+      }
+    }
+    EXPECT_GE(options, 2) << command << "\n" << r.output;
+    EXPECT_LE(options, 20) << command << "\n" << r.output;
+    EXPECT_THAT(r.output, HasSubstr("--helpfull")) << command;
+  }
+  const RunResult calibrate = RunStcalib("calibrate --help");
+  EXPECT_THAT(calibrate.output, HasSubstr("  --drive "));
+  EXPECT_THAT(calibrate.output, HasSubstr("  --perturb_time_s "));
+  EXPECT_THAT(calibrate.output, Not(HasSubstr("--tracking_gain")));
+  EXPECT_THAT(RunStcalib("calibrate --helpfull").output, HasSubstr("tracking_gain"));
+}
+
 TEST(Cli, InfoAndProjectOnKitti) {
   STCALIB_REQUIRE_KITTI();
   const RunResult info = RunStcalib("info --drive=" + testing::KittiDriveDir());

@@ -14,7 +14,7 @@ Status ConvergenceOptions::Validate() const {
   }
   if (spread_updates < 0) return Status::Error("convergence: spread_updates must be >= 0");
   if (!(min_final_health >= 0 && min_final_health <= 1)) {
-    return Status::Error("convergence: min_final_health (--lost_health) must be in [0, 1]");
+    return Status::Error("convergence: min_final_health must be in [0, 1]");
   }
   return health_check.Validate();
 }
