@@ -64,6 +64,14 @@ cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
   }
   cv::putText(canvas, title, cv::Point(10, 22), cv::FONT_HERSHEY_SIMPLEX, 0.6,
               cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  // Legend, bottom left: what the two colours mean.
+  const int y = canvas.rows - 12;
+  cv::circle(canvas, cv::Point(14, y - 4), 4, cv::Scalar(60, 255, 60), cv::FILLED);
+  cv::putText(canvas, "LiDAR edge point within 2 px of an image edge", cv::Point(24, y),
+              cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  cv::circle(canvas, cv::Point(14, y - 22), 4, cv::Scalar(40, 40, 255), cv::FILLED);
+  cv::putText(canvas, "LiDAR edge point farther from every image edge", cv::Point(24, y - 18),
+              cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   return canvas;
 }
 
@@ -480,13 +488,27 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
         {"truth", std::vector<double>(xs.size(), 1000 * outcome->reference_state.time_offset_s),
          cv::Scalar(140, 140, 140)});
   }
+  // An axis the verdict did not observe is marked "held" in the legend: its line is the start's
+  // value, not an estimate.
+  auto label = [&](const char* name, int axis) {
+    return std::string(name) + (outcome->observable[axis] ? "" : " (held)");
+  };
+  std::string held_translation;
+  for (int k = 3; k < 6; ++k) {
+    if (!outcome->observable[k]) {
+      held_translation +=
+          (held_translation.empty() ? "; held: " : ", ") + std::string(kAxisNames[k]).substr(0, 1);
+    }
+  }
+  // δ unobserved is not held at its start: it rests on the forward translation's prior.
+  if (!outcome->observable[6]) dt_series.front().name = "delta (on the prior)";
   std::vector<cv::Mat> panels = {
       PlotPanel("rotation " + vs + " [deg]", xs,
                 {{"total", rot_err, cv::Scalar(0, 0, 0)},
-                 {"roll", roll_e, cv::Scalar(0, 0, 220)},
-                 {"pitch", pitch_e, cv::Scalar(0, 160, 0)},
-                 {"yaw", yaw_e, cv::Scalar(220, 0, 0)}}),
-      PlotPanel("translation " + vs + " [cm]", xs,
+                 {label("roll", 0), roll_e, cv::Scalar(0, 0, 220)},
+                 {label("pitch", 1), pitch_e, cv::Scalar(0, 160, 0)},
+                 {label("yaw", 2), yaw_e, cv::Scalar(220, 0, 0)}}),
+      PlotPanel("translation " + vs + " [cm]" + held_translation, xs,
                 {{"|t|", trans_err_cm, cv::Scalar(120, 0, 120)}}),
       PlotPanel("time offset estimate [ms]" +
                     std::string(polished ? "; each panel's last step: the polish" : ""),

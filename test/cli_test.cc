@@ -908,6 +908,14 @@ TEST(Cli, CalibratesAnotherCameraAndImageSize) {
   ASSERT_TRUE(ReadImage(out + "/overlay_after.png", &overlay).ok());
   EXPECT_EQ(overlay.cols, 1280);
   EXPECT_EQ(overlay.rows, 720);
+  // The legend, bottom left: a green dot (on an image edge) and a red one (off every edge).
+  ASSERT_EQ(overlay.type(), CV_8UC3);
+  const cv::Vec3b green = overlay.at<cv::Vec3b>(overlay.rows - 16, 14);
+  const cv::Vec3b red = overlay.at<cv::Vec3b>(overlay.rows - 34, 14);
+  EXPECT_GT(green[1], 200);
+  EXPECT_LT(green[2], 120);
+  EXPECT_GT(red[2], 200);
+  EXPECT_LT(red[1], 120);
 }
 
 // `stcalib demo`, what scripts/demo runs: it simulates a drive (δ = +30 ms, moving objects),

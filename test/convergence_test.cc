@@ -69,6 +69,29 @@ ConvergenceVerdict VerdictWithCovariance(double rotation_std_rad, double transla
   return verdict;
 }
 
+// Each sweep enters the local maps of `shared_sweep_frames` frames, so the refinement counts its
+// points that many times: the reported covariance stds grow by √ of it (here 4: twice); the
+// polish's pair (δ, forward translation) and the rotation jackknife's floor stand as measured.
+TEST(Convergence, ReportedStdCountsEachSweepOnce) {
+  ConvergenceVerdict verdict =
+      VerdictWithCovariance(0.03, 0.01, Eigen::Vector3d::UnitZ(), 0.02, 0.005);
+  const ReportedUncertainty once = ReportUncertainty(verdict, true, 0.04);
+  verdict.shared_sweep_frames = 4;
+  const ReportedUncertainty four = ReportUncertainty(verdict, true, 0.04);
+  for (int k = 0; k < 5; ++k) {  // camera z is along travel (the pair's), δ the pair's
+    ASSERT_TRUE(once.has_std[k] && four.has_std[k]) << kAxisNames[k];
+    EXPECT_NEAR(four.std_dev[k], 2 * once.std_dev[k], 1e-12) << kAxisNames[k];
+  }
+  // Along travel: the across part doubled, the pair's forward std as it was.
+  EXPECT_NEAR(four.std_dev[5], std::sqrt(0.02 * 0.02 + 0.02 * 0.02), 1e-12);
+  EXPECT_NEAR(four.std_dev[6], 0.005, 1e-12);
+  verdict.rotation_jackknife.frames = 12;
+  verdict.rotation_jackknife.std_deg = Eigen::Vector3d(0.5, 0.0, 0.0);
+  const ReportedUncertainty floored = ReportUncertainty(verdict, true, 0.04);
+  EXPECT_DOUBLE_EQ(floored.std_dev[0], 0.5);
+  EXPECT_DOUBLE_EQ(floored.std_dev[1], four.std_dev[1]);
+}
+
 // The reported std and observability along the direction of travel come from the polish's solve
 // with δ and the forward translation both free, not from the tracking refinement that holds the
 // forward translation with its prior (KITTI: 1 mm there against 4-7 cm with both free).

@@ -147,6 +147,9 @@ struct ConvergenceVerdict {
   // The rotation's jackknife over the refinement's frames (when measured: frames > 0); the
   // reported rotation std is at least its std.
   RotationJackknife rotation_jackknife;
+  // Frames each sweep's points appear in (1 + the oldest sweep age of the window's local maps):
+  // the reported covariance stds are √ of it larger than the refinement's (ReportUncertainty).
+  int shared_sweep_frames = 1;
   std::vector<RuleOutcome> rules;  ///< every rule's outcome (Judge)
 };
 
