@@ -210,23 +210,58 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   const std::string why = RefusalReason(*frame);
   if (!why.empty()) return SkipFrame(frame->index, why);
   last_camera_time_s_ = frame->camera_time_s;
+  const bool refit = DropFoldsOnceAcquired();
+  FrameReport report;
+  report.frame = frame->index;
+  report.acquiring = acquiring();
+  report.before = report.after = state_;
+  report.phase = phase_;
+  AdmitToWindow(*frame);
+  const std::vector<const CalibrationFrame*> frames = SearchWindow();
+  for (const CalibrationFrame* f : frames) report.points += static_cast<int>(f->size());
+  if (report.points < 30) {
+    report.reason = "too few LiDAR edge points in the image (" + std::to_string(report.points) +
+                    "): estimate kept";
+    return report;
+  }
+  // The estimate on the search window; the health reads every point, folds included.
+  WindowScorer scorer(frames, ScoreOptionsInUse());
+  std::optional<WindowScorer> own_health_scorer;
+  WindowScorer* health_scorer = HealthScorer(frames, &scorer, &own_health_scorer);
+  report.score_before = scorer.Evaluate(state_, -1);
+  report.gray_rate_before = scorer.GrayRate(state_);
+  report.health_before = HealthScore(health_scorer, state_, kHealthRotationDeg, kHealthTranslationM,
+                                     nullptr, &health_cache_);
+  const int window_size = static_cast<int>(frames.size());
+  UpdatePhase(window_size, report.health_before);
+  const std::string wait = WhyNoUpdate(window_size, update_now || refit, report.health_before);
+  if (!wait.empty()) return KeepEstimate(report, wait);
+  // The paper's update: search (grid and δ scan first while acquiring or lost), refine, choose.
+  Update(&scorer, refit, &report);
+  MeasureEstimate(&scorer, health_scorer, report.accepted, &report);
+  RememberIfHealthy(report.health, window_size);
+  UpdatePhase(window_size, report.health);
+  report.phase = phase_;
+  return report;
+}
+
+bool OnlineCalibrator::DropFoldsOnceAcquired() {
   // From the first frame after the acquisition (its last update and a polish right after it read
   // the frames the estimate was acquired on). Without the grid's acquisition there is none to
   // end, and the folds stay. Once dropped they stay out, of a lost estimate's grid too. The
-  // first frame without them that updates does so at once and by a full step (`refit`): the
+  // first frame without them that updates does so at once and by a full step (the refit): the
   // estimate was acquired with the folds, and its translation carries their bias.
   if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && Acquires() &&
       !acquiring() && !folds_dropped_) {
     folds_dropped_ = true;
     refit_pending_ = true;
   }
-  const bool refit = refit_pending_;
-  FrameReport report;
-  report.frame = frame->index;
-  report.acquiring = acquiring();
-  report.before = report.after = state_;
+  return refit_pending_;
+}
+
+void OnlineCalibrator::AdmitToWindow(const CalibrationFrame& frame) {
   WindowFrame in_window;
-  in_window.all = PruneToImage(*frame, state_, options_.point_margin);
+  in_window.all = PruneToImage(frame, state_, options_.point_margin);
   in_window.without_folds = options_.folds == OnlineCalibratorOptions::Folds::kKeep
                                 ? in_window.all
                                 : WithoutFolds(in_window.all);
@@ -241,64 +276,42 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
          std::max(options_.window_frames, options_.refine_frames)) {
     window_.pop_front();
   }
-  const std::vector<const CalibrationFrame*> frames = SearchWindow();
-  for (const CalibrationFrame* f : frames) report.points += static_cast<int>(f->size());
-  if (report.points < 30) {
-    report.reason = "too few LiDAR edge points in the image (" + std::to_string(report.points) +
-                    "): estimate kept";
-    report.phase = phase_;
-    return report;
-  }
-  WindowScorer scorer(frames, ScoreOptionsInUse());
-  report.score_before = scorer.Evaluate(state_, -1);
-  report.gray_rate_before = scorer.GrayRate(state_);
-  // The health reads every point, folds included (see HealthWindow).
-  std::optional<WindowScorer> own_health_scorer;
-  WindowScorer* health_scorer = HealthScorer(frames, &scorer, &own_health_scorer);
-  report.health_before = HealthScore(health_scorer, state_, kHealthRotationDeg, kHealthTranslationM,
-                                     nullptr, &health_cache_);
-  const int window_size = static_cast<int>(frames.size());
-  UpdatePhase(window_size, report.health_before);
+}
+
+std::string OnlineCalibrator::WhyNoUpdate(int window_size, bool update_now, double health_before) {
   if (options_.wait_for_full_window && phase_ == Phase::kFilling) {
-    return KeepEstimate(report, "window filling (" + std::to_string(frames.size()) + " of " +
-                                    std::to_string(options_.window_frames) +
-                                    " frames): estimate kept");
+    return "window filling (" + std::to_string(window_size) + " of " +
+           std::to_string(options_.window_frames) + " frames): estimate kept";
   }
-  const bool tracking = phase_ == Phase::kTracking;
-  if (tracking && !update_now && !refit &&
+  if (phase_ == Phase::kTracking && !update_now &&
       ++frames_since_update_ < options_.tracking_update_every) {
-    RememberIfHealthy(report.health_before, frames.size());
-    return KeepEstimate(report,
-                        "tracking: healthy, next update in " +
-                            std::to_string(options_.tracking_update_every - frames_since_update_) +
-                            " frame(s): estimate kept");
+    RememberIfHealthy(health_before, window_size);
+    return "tracking: healthy, next update in " +
+           std::to_string(options_.tracking_update_every - frames_since_update_) +
+           " frame(s): estimate kept";
   }
   frames_since_update_ = 0;
+  return "";
+}
+
+void OnlineCalibrator::Update(WindowScorer* scorer, bool full_step, FrameReport* report) {
   // Coarse-to-fine from the widest map when lost or while the window fills, else the finest map.
-  report.coarse_search = report.health_before < options_.lost_health ||
-                         (options_.coarse_until_window_full &&
-                          static_cast<int>(frames.size()) < options_.window_frames);
-  const std::vector<const CalibrationFrame*> refine_frames = RefineWindow();
+  report->coarse_search = report->health_before < options_.lost_health ||
+                          (options_.coarse_until_window_full &&
+                           static_cast<int>(scorer->num_frames()) < options_.window_frames);
   // The refinement's frames, every point of their maps: the grid's window and the judge of the
   // candidates.
   WindowScorer long_scorer(LatestFrames(options_.refine_frames), ScoreOptionsInUse());
   AdaptiveGridSearchOptions search_options = options_.search;
-  Search(&scorer, &long_scorer, &search_options, &report);
-
+  Search(scorer, &long_scorer, &search_options, report);
   const auto start = std::chrono::steady_clock::now();
-  report.refine = Refine(refine_frames, report.search.state, report.search.state, anchor_,
-                         RefineOptionsInUse());
-  report.refine_ms = MillisecondsSince(start);
-
-  Choose(Candidates(&scorer, search_options, &report), &long_scorer, search_options, refit,
-         &report);
+  report->refine = Refine(RefineWindow(), report->search.state, report->search.state, anchor_,
+                          RefineOptionsInUse());
+  report->refine_ms = MillisecondsSince(start);
+  Choose(Candidates(scorer, search_options, report), &long_scorer, search_options, full_step,
+         report);
   refit_pending_ = false;
-  state_ = report.after;
-  MeasureEstimate(&scorer, health_scorer, report.accepted, &report);
-  RememberIfHealthy(report.health, frames.size());
-  UpdatePhase(window_size, report.health);
-  report.phase = phase_;
-  return report;
+  state_ = report->after;
 }
 
 void OnlineCalibrator::UpdatePhase(int window_size, double health, bool grid_agreed) {

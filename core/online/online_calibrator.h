@@ -312,7 +312,18 @@ class OnlineCalibrator {
 
   // The steps of AddFrame.
   std::string RefusalReason(const CalibrationFrame& frame) const;  ///< empty when usable
-  std::vector<const CalibrationFrame*> RefineWindow() const;       ///< latest refine_frames
+  // Drops the folds on the first frame after the acquisition (Folds::kDropWhenTracking); true
+  // while the first update without them (a full step) is still to run.
+  bool DropFoldsOnceAcquired();
+  // The frame pruned to the image at the estimate, with and without its folds, joins the window.
+  void AdmitToWindow(const CalibrationFrame& frame);
+  // Why this frame runs no update (window filling; tracking between updates, unless
+  // `update_now`), or empty when it does; counts the frames between tracking updates.
+  std::string WhyNoUpdate(int window_size, bool update_now, double health_before);
+  // Search, refinement and choice on `scorer`'s window (the search window); moves the estimate
+  // to report->after (by a full step when `full_step`).
+  void Update(WindowScorer* scorer, bool full_step, FrameReport* report);
+  std::vector<const CalibrationFrame*> RefineWindow() const;  ///< latest refine_frames
   // Rotation grid (when lost or acquiring; ends acquisition when it agrees with the estimate on
   // a full window) then the adaptive search: fills report->search and search_ms.
   void Search(WindowScorer* scorer, WindowScorer* long_scorer,
