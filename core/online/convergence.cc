@@ -379,8 +379,8 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   ConvergenceEvidence evidence =
       GatherEvidence(calibrator, reports, initial, online, options, &verdict);
   Judgement judgement = Judge(evidence, options);
-  // The jackknife (a refinement per frame) and the check on texture-suppressed maps (a health
-  // score per window) are measured only when the rules before them pass.
+  // The jackknife (a refinement per block of frames) and the check on texture-suppressed maps (a
+  // health score per window) are measured only when the rules before them pass.
   auto only_these_fail = [&](std::initializer_list<const char*> names) {
     for (const RuleOutcome& rule : judgement.rules) {
       if (rule.passed) continue;
@@ -390,18 +390,18 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
     }
     return true;
   };
+  // The refinement's frames, as GatherEvidence read them for the profiles.
+  const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
   if (only_these_fail({kJackknifeRule, kSuppressedCheckRule})) {
-    const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
     std::vector<const CalibrationFrame*> frames;
     for (const auto& frame : recent) frames.push_back(frame.get());
     evidence.rotation_jackknife = JackknifeRotation(frames, verdict.estimate, initial,
                                                     calibrator.RefineOptionsInUse(/*polish=*/true),
-                                                    SharedSweepFrames(frames));
+                                                    verdict.shared_sweep_frames);
     verdict.rotation_jackknife = *evidence.rotation_jackknife;
     judgement = Judge(evidence, options);
   }
   if (options.check_suppressed_health && only_these_fail({kSuppressedCheckRule})) {
-    const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
     const size_t keep = std::min<size_t>(recent.size(), options.check_frames);
     const std::vector<std::shared_ptr<const CalibrationFrame>> frames(recent.end() - keep,
                                                                       recent.end());
