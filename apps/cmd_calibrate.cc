@@ -223,7 +223,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   }
 
   OnlineCalibrator calibrator(job.online, initial);
-  std::shared_ptr<const CalibrationFrame> first_frame, last_frame;
+  std::shared_ptr<const CalibrationFrame> last_frame;
   const auto run_start = std::chrono::steady_clock::now();
   double frame_ms_sum = 0;
   int frames_used = 0;
@@ -251,7 +251,6 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     frame_ms_sum +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!report.skipped) {
-      if (!first_frame) first_frame = frame;
       last_frame = frame;
       ++frames_used;
     }

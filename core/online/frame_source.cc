@@ -8,6 +8,22 @@
 
 namespace stcalib {
 
+namespace {
+
+// A frame stays in the calibrator's window for up to refine_frames frames, and every full-size
+// float map costs width × height × 4 bytes (1.9 MB on KITTI). Of its image features the frame's
+// readers need only what CalibrationFrame does not hold itself: the edge count
+// (ImageFeatures::empty), the texture-suppressed IDTs (the verdict's health check), the raw
+// distance map and the edge mask (the overlays).
+void ReleaseMapsNotRead(ImageFeatures* features) {
+  features->distance_vertical_raw_px.release();
+  features->distance_horizontal_raw_px.release();
+  features->segments.clear();
+  features->segments.shrink_to_fit();
+}
+
+}  // namespace
+
 Status FrameSourceOptions::Validate() const {
   STCALIB_RETURN_IF_ERROR(image.Validate());
   return lidar.Validate();
@@ -99,6 +115,8 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
     if (!out->distance_px[kind].empty()) cv::minMaxLoc(out->distance_px[kind], nullptr, &max_value);
     out->distance_cap_px = std::max(out->distance_cap_px, max_value);
   }
+
+  ReleaseMapsNotRead(&out->image);
 
   LidarEdges map;
   LocalMapStats stats;

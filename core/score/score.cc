@@ -51,6 +51,28 @@ inline void AddProjection(const Eigen::Vector3d& h, const MapView& map, float w,
   AddSample(h.x() / h.z(), h.y() / h.z(), map, w, &value->score, &value->projected);
 }
 
+// A LiDAR point p (at its sweep's stamp) of a frame under a calibration, in one affine map:
+// h = K·R_rect·(R·(Rv·p + tv) + t) + p4 = M·p + b, and depth = depth_row·p + depth_offset, with
+// Tv = (Rv, tv) the motion model over e0 + δ.
+struct FrameProjection {
+  Eigen::Matrix3d M;
+  Eigen::Vector3d b;
+  Eigen::Vector3d depth_row;
+  double depth_offset;
+};
+FrameProjection ProjectionOf(const CalibrationFrame& cf, const Eigen::Matrix3d& R,
+                             const Eigen::Vector3d& t, const Rigid3d& Tv) {
+  const Eigen::Matrix3d KR = cf.camera.P_rect_02.leftCols<3>() * cf.camera.R_rect_00;
+  const Eigen::Matrix3d R_total = R * Tv.linear();
+  const Eigen::Vector3d t_total = R * Tv.translation() + t;
+  FrameProjection p;
+  p.M = KR * R_total;
+  p.b = KR * t_total + cf.camera.P_rect_02.col(3);
+  p.depth_row = (cf.camera.R_rect_00.row(2) * R_total).transpose();
+  p.depth_offset = cf.camera.R_rect_00.row(2).dot(t_total);
+  return p;
+}
+
 }  // namespace
 
 const std::vector<Eigen::Matrix<double, 6, 1>>& NeighbourDirections(bool translation) {
@@ -104,11 +126,14 @@ WindowScorer::WindowScorer(std::vector<const CalibrationFrame*> frames, const Sc
                                                ? options.horizontal_weight
                                                : 1.0 - options.horizontal_weight));
     }
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(selected.size());
+    for (int i : selected) points.push_back(f->points_lidar[i]);
     selected_.push_back(std::move(selected));
     weights_.push_back(std::move(weights));
     kinds_.push_back(std::move(kinds));
+    points_.push_back(std::move(points));
   }
-  moved_.resize(frames_.size());
 }
 
 int WindowScorer::num_levels() const {
@@ -117,21 +142,6 @@ int WindowScorer::num_levels() const {
     levels = std::min<int>(levels, std::min(f->score_maps[0].size(), f->score_maps[1].size()));
   }
   return frames_.empty() ? 0 : levels;
-}
-
-const std::vector<Eigen::Vector3d>& WindowScorer::Moved(size_t frame, double time_offset_s) {
-  if (time_offset_s != cached_time_offset_s_) {
-    for (size_t f = 0; f < frames_.size(); ++f) {
-      const CalibrationFrame& cf = *frames_[f];
-      const double e = cf.e0_s + time_offset_s;
-      moved_[f].resize(selected_[f].size());
-      for (size_t k = 0; k < selected_[f].size(); ++k) {
-        moved_[f][k] = ApplyLidarMotion<double>(cf.twist, e, cf.points_lidar[selected_[f][k]]);
-      }
-    }
-    cached_time_offset_s_ = time_offset_s;
-  }
-  return moved_[frame];
 }
 
 ScoreValue WindowScorer::EvaluateLevel(const CalibrationState& state, int level, size_t begin,
@@ -174,18 +184,15 @@ ScoreValue WindowScorer::EvaluateOn(const CalibrationState& state, const MapOf& 
   for (size_t f = begin; f < end; ++f) {
     const CalibrationFrame& cf = *frames_[f];
     const MapView maps[2] = {MapView(map_of(cf, 0)), MapView(map_of(cf, 1))};
-    const std::vector<Eigen::Vector3d>& moved = Moved(f, state.time_offset_s);
-    // h = K·R_rect·(R·p + t) + p4 = M·p + b.
-    const Eigen::Matrix3d KR = cf.camera.P_rect_02.leftCols<3>() * cf.camera.R_rect_00;
-    const Eigen::Matrix3d M = KR * state.T_camera_lidar.linear();
-    const Eigen::Vector3d b = KR * state.T_camera_lidar.translation() + cf.camera.P_rect_02.col(3);
-    const Eigen::Vector3d depth_row = cf.camera.R_rect_00.row(2) * state.T_camera_lidar.linear();
-    const double depth_offset = cf.camera.R_rect_00.row(2).dot(state.T_camera_lidar.translation());
-    for (size_t k = 0; k < moved.size(); ++k) {
+    const std::vector<Eigen::Vector3d>& points = points_[f];
+    const FrameProjection p =
+        ProjectionOf(cf, state.T_camera_lidar.linear(), state.T_camera_lidar.translation(),
+                     LidarMotion(cf.twist, cf.e0_s + state.time_offset_s));
+    for (size_t k = 0; k < points.size(); ++k) {
       const float w = weights_[f][k];
       weight_sum += w;
-      if (depth_row.dot(moved[k]) + depth_offset < cf.camera.min_depth_m) continue;
-      const Eigen::Vector3d h = M * moved[k] + b;
+      if (p.depth_row.dot(points[k]) + p.depth_offset < cf.camera.min_depth_m) continue;
+      const Eigen::Vector3d h = p.M * points[k] + p.b;
       AddProjection(h, maps[kinds_[f][k]], w, &value);
     }
   }
@@ -242,22 +249,24 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
     CHECK(l >= 0 && l < maps_count && l < static_cast<int>(cf.score_maps[1].size()))
         << "score level " << level << " of " << maps_count;
     const MapView maps[2] = {MapView(cf.score_maps[0][l]), MapView(cf.score_maps[1][l])};
-    const std::vector<Eigen::Vector3d>& moved = Moved(f, states[0].time_offset_s);
+    const std::vector<Eigen::Vector3d>& moved = points_[f];
     for (size_t k = 0; k < moved.size(); ++k) weight_sum += weights_[f][k];
     // As EvaluateOn: h = M·p + b, depth = depth_row·p + depth_offset.
-    const Eigen::Matrix3d KR = cf.camera.P_rect_02.leftCols<3>() * cf.camera.R_rect_00;
+    const Rigid3d Tv = LidarMotion(cf.twist, cf.e0_s + states[0].time_offset_s);
     for (size_t g = 0; g < groups.size(); ++g) {
       const Eigen::Matrix3d& R = states[groups[g].front()].T_camera_lidar.linear();
-      M[g] = KR * R;
-      depth_row[g] = (cf.camera.R_rect_00.row(2) * R).transpose();
       for (size_t j = 0; j < groups[g].size(); ++j) {
-        const Eigen::Vector3d& t = states[groups[g][j]].T_camera_lidar.translation();
-        const Eigen::Vector3d b = KR * t + cf.camera.P_rect_02.col(3);
+        const FrameProjection p =
+            ProjectionOf(cf, R, states[groups[g][j]].T_camera_lidar.translation(), Tv);
+        if (j == 0) {
+          M[g] = p.M;
+          depth_row[g] = p.depth_row;
+        }
         const size_t lane = lane_begin[g] + j;
-        bx[lane] = b.x();
-        by[lane] = b.y();
-        bz[lane] = b.z();
-        depth_offset[lane] = cf.camera.R_rect_00.row(2).dot(t);
+        bx[lane] = p.b.x();
+        by[lane] = p.b.y();
+        bz[lane] = p.b.z();
+        depth_offset[lane] = p.depth_offset;
       }
     }
     const double min_depth_m = cf.camera.min_depth_m;

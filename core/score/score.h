@@ -24,8 +24,9 @@ struct ScoreValue {
   double weight_sum = 0;  ///< sum of the point weights (score = 255·gray_rate·weight_sum)
 };
 
-// Evaluates many candidate calibrations on a window of frames fast: the points carried by the
-// motion model are cached per time offset, and each candidate costs one 3×3 product per point.
+// Evaluates many candidate calibrations on a window of frames fast: the motion model's Tv(e0 + δ)
+// is one rigid transform per frame, folded with the candidate's extrinsic and the camera into one
+// 3×4 projection, so each candidate (any δ) costs one 3×3 product per point.
 class WindowScorer {
  public:
   WindowScorer(std::vector<const CalibrationFrame*> frames, const ScoreOptions& options);
@@ -52,11 +53,6 @@ class WindowScorer {
   ScoreValue EvaluateFrame(size_t f, const CalibrationState& state, int level);
 
  private:
-  struct FramePoints {
-    std::vector<Eigen::Vector3d> moved;  // Tv(e0 + δ)·p for the cached δ
-    std::vector<float> weight;
-  };
-  const std::vector<Eigen::Vector3d>& Moved(size_t frame, double time_offset_s);
   // Evaluates frames [begin, end) on the map `map_of(frame, kind)`.
   template <typename MapOf>
   ScoreValue EvaluateOn(const CalibrationState& state, const MapOf& map_of, size_t begin,
@@ -72,8 +68,7 @@ class WindowScorer {
   std::vector<std::vector<int>> selected_;  // thinned point indices per frame
   std::vector<std::vector<float>> weights_;
   std::vector<std::vector<uint8_t>> kinds_;
-  double cached_time_offset_s_ = std::numeric_limits<double>::quiet_NaN();
-  std::vector<std::vector<Eigen::Vector3d>> moved_;
+  std::vector<std::vector<Eigen::Vector3d>> points_;  // the thinned points per frame
 };
 
 // The 728 neighbour directions of the 6-DoF grid (docs/method.md §6), each component in {−1, 0, 1}
