@@ -19,6 +19,7 @@
 #include "core/io/kitti_calib.h"
 #include "core/io/text.h"
 #include "core/online/convergence.h"
+#include "core/online/frame_prefetcher.h"
 #include "core/search/adaptive_grid_search.h"
 
 namespace stcalib::cli {
@@ -227,15 +228,19 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const auto run_start = std::chrono::steady_clock::now();
   double frame_ms_sum = 0;
   int frames_used = 0;
-  for (int i = first; i <= last; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    auto frame = std::make_shared<CalibrationFrame>();
-    status = source->Load(i, frame.get());
-    if (!status.ok()) {
+  // The next frame is read and its features computed on a second thread while this one is
+  // calibrated; a frame's time is the wait for it plus its calibration.
+  FramePrefetcher frames(source.get(), first, last);
+  FramePrefetcher::Loaded loaded;
+  for (auto t0 = std::chrono::steady_clock::now(); frames.Next(&loaded);
+       t0 = std::chrono::steady_clock::now()) {
+    const int i = loaded.index;
+    if (!loaded.status.ok()) {
       // Bad data in one frame (unreadable sweep or image, oxts gap): keep the estimate, go on.
-      outcome->reports.push_back(calibrator.SkipFrame(i, status.message()));
+      outcome->reports.push_back(calibrator.SkipFrame(i, loaded.status.message()));
       continue;
     }
+    std::shared_ptr<const CalibrationFrame> frame = std::move(loaded.frame);
     if (i == job.disturb_frame) {
       const Eigen::Vector3d d(sign() * job.disturb_rot_deg, sign() * job.disturb_rot_deg,
                               sign() * job.disturb_rot_deg);

@@ -7,10 +7,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <tuple>
 
+#include "core/online/frame_prefetcher.h"
 #include "core/online/frame_source.h"
 #include "core/online/online_calibrator.h"
 #include "core/refine/refine.h"
@@ -72,6 +74,61 @@ TEST(FrameSource, CameraAzimuthWindowHoldsTheFieldOfView) {
   whole.view_margin_deg = -1;
   ASSERT_TRUE(DriveFrameSource::Create(&drive, whole, &source).ok());
   EXPECT_EQ(source->dynamic_options().roi_half_angle_deg, 0.0);
+}
+
+// The prefetcher (calibrate's loader thread) returns the frames in order, each the same as a
+// direct load on the caller's thread.
+TEST(FramePrefetcher, ReturnsTheFramesInOrderAsADirectLoadDoes) {
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
+  const std::vector<std::shared_ptr<const CalibrationFrame>> direct =
+      testing::LoadCalibrationFrames(drive, FrameSourceOptions(), {3, 4, 5});
+  ASSERT_EQ(direct.size(), 3u);
+  std::unique_ptr<DriveFrameSource> source;
+  ASSERT_TRUE(DriveFrameSource::Create(&drive, FrameSourceOptions(), &source).ok());
+  FramePrefetcher prefetcher(source.get(), 3, 5);
+  FramePrefetcher::Loaded loaded;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(prefetcher.Next(&loaded));
+    EXPECT_EQ(loaded.index, 3 + k);
+    ASSERT_TRUE(loaded.status.ok()) << loaded.status.message();
+    EXPECT_EQ(loaded.frame->camera_time_s, direct[k]->camera_time_s);
+    EXPECT_EQ(loaded.frame->e0_s, direct[k]->e0_s);
+    ASSERT_EQ(loaded.frame->size(), direct[k]->size());
+    EXPECT_EQ(loaded.frame->points_lidar, direct[k]->points_lidar);
+    for (int kind = 0; kind < 2; ++kind) {
+      EXPECT_EQ(cv::norm(loaded.frame->score_maps[kind].back(), direct[k]->score_maps[kind].back(),
+                         cv::NORM_INF),
+                0.0);
+    }
+  }
+  EXPECT_FALSE(prefetcher.Next(&loaded));
+}
+
+// A frame that fails to load comes back in its place with the error naming its file; the frames
+// around it load.
+TEST(FramePrefetcher, ReturnsAFrameThatFailsWithItsError) {
+  testing::ScopedTempDir tmp;
+  const std::string drive_dir = testing::MakeTinyDrive(tmp.path(), 3);
+  const std::string bin = drive_dir + "/velodyne_points/data/0000000001.bin";
+  std::filesystem::resize_file(bin, 10);
+  Drive drive;
+  const Status opened = OpenDrive(drive_dir, "", &drive);
+  ASSERT_TRUE(opened.ok()) << opened.message();
+  FrameSourceOptions options;
+  options.local_map.sweeps = 1;
+  std::unique_ptr<DriveFrameSource> source;
+  const Status created = DriveFrameSource::Create(&drive, options, &source);
+  ASSERT_TRUE(created.ok()) << created.message();
+  FramePrefetcher prefetcher(source.get(), 0, 2);
+  std::vector<FramePrefetcher::Loaded> all(3);
+  for (FramePrefetcher::Loaded& loaded : all) ASSERT_TRUE(prefetcher.Next(&loaded));
+  EXPECT_TRUE(all[0].status.ok()) << all[0].status.message();
+  EXPECT_FALSE(all[1].status.ok());
+  EXPECT_THAT(all[1].status.message(), ::testing::HasSubstr(bin));
+  EXPECT_EQ(all[1].index, 1);
+  EXPECT_TRUE(all[2].status.ok()) << all[2].status.message();
 }
 
 // Fault injection at the calibrator itself: frames that go back in time, repeat a stamp, carry
