@@ -370,6 +370,24 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
       ASSERT_EQ(batch[n].gray_rate, single.gray_rate);
     }
   }
+  // The rotation grid's pass (EvaluateFramePerState: any rotations and translations, one δ) equals
+  // EvaluateFrame state by state, bit for bit, on every frame.
+  {
+    std::vector<CalibrationState> states;
+    for (const Eigen::Matrix<double, 6, 1>& d : NeighbourDirections(true)) {
+      states.push_back(Step(one_off, 0.02 * d.head<3>(), 0.05 * d.tail<3>(), 0.0));
+    }
+    for (size_t f = 0; f < scorer.num_frames(); ++f) {
+      const std::vector<ScoreValue> batch = scorer.EvaluateFramePerState(f, states, -1);
+      ASSERT_EQ(batch.size(), states.size());
+      for (size_t n = 0; n < states.size(); ++n) {
+        const ScoreValue single = scorer.EvaluateFrame(f, states[n], -1);
+        ASSERT_EQ(batch[n].score, single.score) << "frame " << f << ", state " << n;
+        ASSERT_EQ(batch[n].projected, single.projected) << "frame " << f << ", state " << n;
+        ASSERT_EQ(batch[n].weight_sum, single.weight_sum);
+      }
+    }
+  }
 
   // The health cache: a window sliding one frame at a time with the estimate unchanged scores
   // only its newest frame, and every health and best gain equals the uncached one exactly; a

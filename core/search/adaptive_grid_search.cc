@@ -176,6 +176,13 @@ RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationSta
   }
   RotationGridCache local;
   const std::vector<uint8_t> mask = in_bounds;
+  std::vector<CalibrationState> scored_points;  // the lattice points inside the bounds
+  std::vector<size_t> scored_index;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!mask[i]) continue;
+    scored_points.push_back(points[i]);
+    scored_index.push_back(i);
+  }
   // Per-frame scores, from the cache or computed.
   const std::vector<const std::vector<double>*> frame_scores =
       (cache != nullptr ? cache : &local)
@@ -184,10 +191,11 @@ RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationSta
                          step_deg, level, scorer->options().horizontal_weight,
                          scorer->options().max_points_per_frame, std::move(in_bounds)},
                         [&](size_t f) {
+                          const std::vector<ScoreValue> values =
+                              scorer->EvaluateFramePerState(f, scored_points, level);
                           std::vector<double> scores(points.size(), 0.0);
-                          for (size_t i = 0; i < points.size(); ++i) {
-                            if (mask[i])
-                              scores[i] = scorer->EvaluateFrame(f, points[i], level).score;
+                          for (size_t k = 0; k < values.size(); ++k) {
+                            scores[scored_index[k]] = values[k].score;
                           }
                           return scores;
                         });
