@@ -76,6 +76,32 @@ TEST(FrameSource, CameraAzimuthWindowHoldsTheFieldOfView) {
   EXPECT_EQ(source->dynamic_options().roi_half_angle_deg, 0.0);
 }
 
+// A loaded frame scores on the band-pass IDTs and does not keep the texture-suppressed ones:
+// TextureSuppressedMap gives them back, bit for bit those of the image features.
+TEST(FrameSource, TextureSuppressedMapsComeBackFromTheBandPassScoreMaps) {
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive));
+  const FrameSourceOptions options;
+  const std::vector<std::shared_ptr<const CalibrationFrame>> frames =
+      testing::LoadCalibrationFrames(drive, options, {3});
+  ASSERT_EQ(frames.size(), 1u);
+  const CalibrationFrame& frame = *frames[0];
+  ASSERT_TRUE(frame.score_maps_bandpass);
+  cv::Mat image;
+  ASSERT_TRUE(drive.LoadImage(3, &image).ok());
+  const ImageFeatures features = ExtractImageFeatures(image, options.ImageOptions());
+  for (int kind = 0; kind < 2; ++kind) {
+    EXPECT_TRUE(frame.image.oriented[kind].idt_suppressed.empty()) << "released, kind " << kind;
+    const cv::Mat derived = TextureSuppressedMap(frame, kind);
+    const cv::Mat& expected = features.oriented[kind].idt_suppressed;
+    ASSERT_FALSE(expected.empty());
+    ASSERT_EQ(derived.size(), expected.size());
+    EXPECT_EQ(cv::norm(derived, expected, cv::NORM_INF), 0.0) << "kind " << kind;
+    EXPECT_GT(cv::norm(derived, cv::NORM_INF), 0.0);
+  }
+}
+
 // The prefetcher (calibrate's loader thread) returns the frames in order, each the same as a
 // direct load on the caller's thread.
 TEST(FramePrefetcher, ReturnsTheFramesInOrderAsADirectLoadDoes) {

@@ -13,11 +13,15 @@ namespace {
 // A frame stays in the calibrator's window for up to refine_frames frames, and every full-size
 // float map costs width × height × 4 bytes (1.9 MB on KITTI). Of its image features the frame's
 // readers need only what CalibrationFrame does not hold itself: the edge count
-// (ImageFeatures::empty), the texture-suppressed IDTs (the verdict's health check), the raw
-// distance map and the edge mask (the overlays).
-void ReleaseMapsNotRead(ImageFeatures* features) {
+// (ImageFeatures::empty), the texture-suppressed IDTs (the verdict's health check) unless the
+// score maps hold them, the raw distance map and the edge mask (the overlays).
+void ReleaseMapsNotRead(bool score_maps_bandpass, ImageFeatures* features) {
   features->distance_vertical_raw_px.release();
   features->distance_horizontal_raw_px.release();
+  if (score_maps_bandpass) {  // TextureSuppressedMap derives them from the score maps
+    features->idt_suppressed.release();
+    for (OrientedMaps& m : features->oriented) m.idt_suppressed.release();
+  }
   features->segments.clear();
   features->segments.shrink_to_fit();
 }
@@ -116,7 +120,8 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
     out->distance_cap_px = std::max(out->distance_cap_px, max_value);
   }
 
-  ReleaseMapsNotRead(&out->image);
+  out->score_maps_bandpass = options_.suppress_texture && options_.bandpass_score;
+  ReleaseMapsNotRead(out->score_maps_bandpass, &out->image);
 
   LidarEdges map;
   LocalMapStats stats;

@@ -10,11 +10,11 @@ namespace stcalib {
 std::shared_ptr<const CalibrationFrame> WithSuppressedScoreMaps(const CalibrationFrame& frame) {
   auto view = std::make_shared<CalibrationFrame>(frame);
   for (int kind = 0; kind < 2; ++kind) {
-    const cv::Mat& oriented = frame.image.oriented[kind].idt_suppressed;
-    const cv::Mat& map = oriented.empty() ? frame.image.idt_suppressed : oriented;
+    const cv::Mat map = TextureSuppressedMap(frame, kind);
     view->score_maps[kind].clear();
     if (!map.empty()) view->score_maps[kind].push_back(map);
   }
+  view->score_maps_bandpass = false;
   return view;
 }
 

@@ -35,7 +35,15 @@ struct FrameImageAndMotion {
   // The largest value of the two distance maps: the residual of a point outside the image [px];
   // 0 = not yet known (the refinement then finds it).
   double distance_cap_px = 0;
+  // The finest score maps are the band-pass IDTs, whose positive parts are the texture-suppressed
+  // IDTs (ImageFeatures::idt_suppressed, which the frame then need not keep: TextureSuppressedMap).
+  bool score_maps_bandpass = false;
 };
+
+// The texture-suppressed IDT of edge kind `kind`: the image features' own, or, when the frame
+// scores on the band-pass IDT, its positive part (the same values: ExtractImageFeatures makes the
+// one from the other). Empty when the frame has neither.
+cv::Mat TextureSuppressedMap(const FrameImageAndMotion& frame, int kind);
 
 // One image with its LiDAR edge points: everything the score, the search and the refinement read.
 // The per-point fields are the ones below; ClearPoints, TakePoints and WithPoints are the only
@@ -62,6 +70,15 @@ struct CalibrationFrame : FrameImageAndMotion {
   // per-point entries; the points are copied, nothing else is (the maps share their data).
   CalibrationFrame WithPoints(const std::vector<size_t>& indices) const;
 };
+
+inline cv::Mat TextureSuppressedMap(const FrameImageAndMotion& frame, int kind) {
+  const cv::Mat& oriented = frame.image.oriented[kind].idt_suppressed;
+  const cv::Mat& own = oriented.empty() ? frame.image.idt_suppressed : oriented;
+  if (!own.empty() || !frame.score_maps_bandpass || frame.score_maps[kind].empty()) return own;
+  cv::Mat positive;
+  cv::max(frame.score_maps[kind].back(), 0.0, positive);
+  return positive;
+}
 
 // Pixel of edge point i of `frame` at `state` (carried by the motion model over e0 + δ, then
 // through T_camera_lidar and the camera); false when it falls behind the camera.
