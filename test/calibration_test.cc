@@ -76,9 +76,9 @@ TEST(FrameSource, CameraAzimuthWindowHoldsTheFieldOfView) {
   EXPECT_EQ(source->dynamic_options().roi_half_angle_deg, 0.0);
 }
 
-// A loaded frame scores on the band-pass IDTs and does not keep the texture-suppressed ones:
-// TextureSuppressedMap gives them back, bit for bit those of the image features.
-TEST(FrameSource, TextureSuppressedMapsComeBackFromTheBandPassScoreMaps) {
+// A loaded frame scores on the band-pass IDTs and keeps neither the texture-suppressed nor the
+// plain IDTs: TextureSuppressedMap and PlainIdt give them back, bit for bit the image features'.
+TEST(FrameSource, SuppressedAndPlainIdtsComeBackBitForBit) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
   ASSERT_TRUE(testing::OpenKittiDrive(&drive));
@@ -99,6 +99,13 @@ TEST(FrameSource, TextureSuppressedMapsComeBackFromTheBandPassScoreMaps) {
     ASSERT_EQ(derived.size(), expected.size());
     EXPECT_EQ(cv::norm(derived, expected, cv::NORM_INF), 0.0) << "kind " << kind;
     EXPECT_GT(cv::norm(derived, cv::NORM_INF), 0.0);
+    // The plain IDT (the gray rate's map) likewise, from the distance map.
+    EXPECT_TRUE(frame.gray_map[kind].empty()) << "released, kind " << kind;
+    const cv::Mat plain = PlainIdt(frame, kind);
+    const cv::Mat& expected_plain = features.oriented[kind].idt;
+    ASSERT_EQ(plain.size(), expected_plain.size());
+    EXPECT_EQ(cv::norm(plain, expected_plain, cv::NORM_INF), 0.0) << "kind " << kind;
+    EXPECT_GT(cv::norm(plain, cv::NORM_INF), 0.0);
   }
 }
 

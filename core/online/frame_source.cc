@@ -122,6 +122,12 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
 
   out->score_maps_bandpass = options_.suppress_texture && options_.bandpass_score;
   ReleaseMapsNotRead(out->score_maps_bandpass, &out->image);
+  if (out->score_maps_bandpass) {  // the plain IDTs are then read by the gray rate only: PlainIdt
+    out->gray_basin_px = options_.ImageOptions().basin_px;
+    for (cv::Mat& map : out->gray_map) map.release();
+    out->image.idt.release();
+    for (OrientedMaps& m : out->image.oriented) m.idt.release();
+  }
 
   LidarEdges map;
   LocalMapStats stats;

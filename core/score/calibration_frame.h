@@ -38,7 +38,15 @@ struct FrameImageAndMotion {
   // The finest score maps are the band-pass IDTs, whose positive parts are the texture-suppressed
   // IDTs (ImageFeatures::idt_suppressed, which the frame then need not keep: TextureSuppressedMap).
   bool score_maps_bandpass = false;
+  // > 0: the frame keeps no gray_map; its plain IDT is 255·(1 − distance_px/gray_basin_px), as
+  // the image features make it from the same distance map (PlainIdt) [px].
+  double gray_basin_px = 0;
 };
+
+// The plain IDT of edge kind `kind` (the gray rate's map): gray_map, or, when the frame keeps
+// none (gray_basin_px > 0), made from its distance map exactly as the image features make it.
+// Empty when the frame has neither.
+cv::Mat PlainIdt(const FrameImageAndMotion& frame, int kind);
 
 // The texture-suppressed IDT of edge kind `kind`: the image features' own, or, when the frame
 // scores on the band-pass IDT, its positive part (the same values: ExtractImageFeatures makes the
@@ -78,6 +86,13 @@ inline cv::Mat TextureSuppressedMap(const FrameImageAndMotion& frame, int kind) 
   cv::Mat positive;
   cv::max(frame.score_maps[kind].back(), 0.0, positive);
   return positive;
+}
+
+inline cv::Mat PlainIdt(const FrameImageAndMotion& frame, int kind) {
+  if (!frame.gray_map[kind].empty() || !(frame.gray_basin_px > 0)) return frame.gray_map[kind];
+  cv::Mat idt;
+  frame.distance_px[kind].convertTo(idt, CV_32F, -255.0 / frame.gray_basin_px, 255.0);
+  return idt;
 }
 
 // Pixel of edge point i of `frame` at `state` (carried by the motion model over e0 + δ, then

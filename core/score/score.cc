@@ -207,10 +207,30 @@ std::vector<ScoreValue> WindowScorer::EvaluateFramePerState(
 }
 
 double WindowScorer::GrayRate(const CalibrationState& state) {
+  // A frame that keeps no plain IDT has it made from its distance map (PlainIdt). A scorer over
+  // a few frames (the search window, whose search reads the gray rate at every step) keeps what
+  // it made; one over more frames (the refinement's, read once or twice) makes each frame's in
+  // turn and drops it, or its maps would add as much memory as the frames hold themselves.
+  constexpr size_t kMaxFramesKeepingPlainIdt = 4;
+  const bool keep = frames_.size() <= kMaxFramesKeepingPlainIdt;
+  if (keep) plain_idt_.resize(frames_.size());
+  std::array<cv::Mat, 2> scratch;
+  const CalibrationFrame* scratch_frame = nullptr;
   return EvaluateOn(
              state,
-             [](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
-               return cf.gray_map[kind].empty() ? cf.score_maps[kind].back() : cf.gray_map[kind];
+             [&](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
+               if (!cf.gray_map[kind].empty()) return cf.gray_map[kind];
+               if (!(cf.gray_basin_px > 0)) return cf.score_maps[kind].back();
+               std::array<cv::Mat, 2>* maps = &scratch;
+               if (keep) {
+                 const size_t f = std::find(frames_.begin(), frames_.end(), &cf) - frames_.begin();
+                 maps = &plain_idt_[f];
+               } else if (scratch_frame != &cf) {  // the previous frame's maps are done with
+                 scratch = {};
+                 scratch_frame = &cf;
+               }
+               if ((*maps)[kind].empty()) (*maps)[kind] = PlainIdt(cf, kind);
+               return (*maps)[kind];
              },
              0, frames_.size())
       .gray_rate;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -76,6 +77,8 @@ class WindowScorer {
   std::vector<std::vector<float>> weights_;
   std::vector<std::vector<uint8_t>> kinds_;
   std::vector<std::vector<Eigen::Vector3d>> points_;  // the thinned points per frame
+  // Plain IDTs made by GrayRate for frames that keep none (PlainIdt), when they are kept.
+  std::vector<std::array<cv::Mat, 2>> plain_idt_;
 };
 
 // The 728 neighbour directions of the 6-DoF grid (docs/method.md §6), each component in {−1, 0, 1}
