@@ -129,7 +129,6 @@ WindowScorer::WindowScorer(std::vector<const CalibrationFrame*> frames, const Sc
     std::vector<Eigen::Vector3d> points;
     points.reserve(selected.size());
     for (int i : selected) points.push_back(f->points_lidar[i]);
-    selected_.push_back(std::move(selected));
     weights_.push_back(std::move(weights));
     kinds_.push_back(std::move(kinds));
     points_.push_back(std::move(points));
@@ -309,8 +308,8 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
     CHECK(l >= 0 && l < maps_count && l < static_cast<int>(cf.score_maps[1].size()))
         << "score level " << level << " of " << maps_count;
     const MapView maps[2] = {MapView(cf.score_maps[0][l]), MapView(cf.score_maps[1][l])};
-    const std::vector<Eigen::Vector3d>& moved = points_[f];
-    for (size_t k = 0; k < moved.size(); ++k) weight_sum += weights_[f][k];
+    const std::vector<Eigen::Vector3d>& points = points_[f];
+    for (size_t k = 0; k < points.size(); ++k) weight_sum += weights_[f][k];
     // As EvaluateOn: h = M·p + b, depth = depth_row·p + depth_offset.
     const Rigid3d Tv = LidarMotion(cf.twist, cf.e0_s + states[0].time_offset_s);
     for (size_t g = 0; g < groups.size(); ++g) {
@@ -333,12 +332,12 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
     // Point by point, every state: one point's samples under all the states lie within a few
     // pixels of each other, so they stay in the cache (state by state, every point, they were
     // fetched again for each rotation). Each state still sums its points in order.
-    for (size_t k = 0; k < moved.size(); ++k) {
+    for (size_t k = 0; k < points.size(); ++k) {
       const float w = weights_[f][k];
       const MapView& map = maps[kinds_[f][k]];
       for (size_t g = 0; g < groups.size(); ++g) {
-        const double depth = depth_row[g].dot(moved[k]);
-        const Eigen::Vector3d Mp = M[g] * moved[k];
+        const double depth = depth_row[g].dot(points[k]);
+        const Eigen::Vector3d Mp = M[g] * points[k];
         const double mx = Mp.x(), my = Mp.y(), mz = Mp.z();
         const size_t first = lane_begin[g], m = groups[g].size();
         // Unaliased lanes, so that the divisions vectorise (each is still one IEEE division).

@@ -73,7 +73,6 @@ class WindowScorer {
 
   std::vector<const CalibrationFrame*> frames_;
   ScoreOptions options_;
-  std::vector<std::vector<int>> selected_;  // thinned point indices per frame
   std::vector<std::vector<float>> weights_;
   std::vector<std::vector<uint8_t>> kinds_;
   std::vector<std::vector<Eigen::Vector3d>> points_;  // the thinned points per frame
