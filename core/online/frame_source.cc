@@ -12,18 +12,25 @@ namespace {
 
 // A frame stays in the calibrator's window for up to refine_frames frames, and every full-size
 // float map costs width × height × 4 bytes (1.9 MB on KITTI). Of its image features the frame's
-// readers need only what CalibrationFrame does not hold itself: the edge count
-// (ImageFeatures::empty), the texture-suppressed IDTs (the verdict's health check) unless the
-// score maps hold them, the raw distance map and the edge mask (the overlays).
-void ReleaseMapsNotRead(bool score_maps_bandpass, ImageFeatures* features) {
-  features->distance_vertical_raw_px.release();
-  features->distance_horizontal_raw_px.release();
-  if (score_maps_bandpass) {  // TextureSuppressedMap derives them from the score maps
-    features->idt_suppressed.release();
-    for (OrientedMaps& m : features->oriented) m.idt_suppressed.release();
+// readers need only what it does not hold itself: the edge count (ImageFeatures::empty), the
+// raw distance map and the edge mask (the overlays). A frame scoring on the band-pass IDTs also
+// drops the texture-suppressed and plain IDTs, which TextureSuppressedMap and PlainIdt make again
+// from its score and distance maps where they are read (the health check, the gray rate).
+void ReleaseMapsNotRead(double basin_px, CalibrationFrame* frame) {
+  ImageFeatures& features = frame->image;
+  features.distance_vertical_raw_px.release();
+  features.distance_horizontal_raw_px.release();
+  features.segments.clear();
+  features.segments.shrink_to_fit();
+  if (!frame->score_maps_bandpass) return;
+  features.idt_suppressed.release();
+  features.idt.release();
+  for (OrientedMaps& m : features.oriented) {
+    m.idt_suppressed.release();
+    m.idt.release();
   }
-  features->segments.clear();
-  features->segments.shrink_to_fit();
+  for (cv::Mat& map : frame->gray_map) map.release();
+  frame->gray_basin_px = basin_px;
 }
 
 }  // namespace
@@ -121,13 +128,7 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   }
 
   out->score_maps_bandpass = options_.suppress_texture && options_.bandpass_score;
-  ReleaseMapsNotRead(out->score_maps_bandpass, &out->image);
-  if (out->score_maps_bandpass) {  // the plain IDTs are then read by the gray rate only: PlainIdt
-    out->gray_basin_px = options_.ImageOptions().basin_px;
-    for (cv::Mat& map : out->gray_map) map.release();
-    out->image.idt.release();
-    for (OrientedMaps& m : out->image.oriented) m.idt.release();
-  }
+  ReleaseMapsNotRead(options_.ImageOptions().basin_px, out);
 
   LidarEdges map;
   LocalMapStats stats;

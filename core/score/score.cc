@@ -73,6 +73,14 @@ FrameProjection ProjectionOf(const CalibrationFrame& cf, const Eigen::Matrix3d& 
   return p;
 }
 
+// The score map of edge kind `kind` at `level` (negative counts from the finest: −1).
+const cv::Mat& ScoreMapAt(const CalibrationFrame& cf, int kind, int level) {
+  const int maps = static_cast<int>(cf.score_maps[kind].size());
+  const int l = level < 0 ? maps + level : level;
+  CHECK(l >= 0 && l < maps) << "score level " << level << " of " << maps;
+  return cf.score_maps[kind][l];
+}
+
 }  // namespace
 
 const std::vector<Eigen::Matrix<double, 6, 1>>& NeighbourDirections(bool translation) {
@@ -148,10 +156,7 @@ ScoreValue WindowScorer::EvaluateLevel(const CalibrationState& state, int level,
   return EvaluateOn(
       state,
       [level](const CalibrationFrame& cf, int kind) -> const cv::Mat& {
-        const int maps = static_cast<int>(cf.score_maps[kind].size());
-        const int l = level < 0 ? maps + level : level;
-        CHECK(l >= 0 && l < maps) << "score level " << level << " of " << maps;
-        return cf.score_maps[kind][l];
+        return ScoreMapAt(cf, kind, level);
       },
       begin, end);
 }
@@ -171,11 +176,7 @@ std::vector<ScoreValue> WindowScorer::EvaluateFramePerState(
   std::vector<ScoreValue> values(states.size());
   if (states.empty()) return values;
   const CalibrationFrame& cf = *frames_[f];
-  const int maps_count = static_cast<int>(cf.score_maps[0].size());
-  const int l = level < 0 ? maps_count + level : level;
-  CHECK(l >= 0 && l < maps_count && l < static_cast<int>(cf.score_maps[1].size()))
-      << "score level " << level << " of " << maps_count;
-  const MapView maps[2] = {MapView(cf.score_maps[0][l]), MapView(cf.score_maps[1][l])};
+  const MapView maps[2] = {MapView(ScoreMapAt(cf, 0, level)), MapView(ScoreMapAt(cf, 1, level))};
   const Rigid3d Tv = LidarMotion(cf.twist, cf.e0_s + states[0].time_offset_s);
   std::vector<FrameProjection> projections;
   projections.reserve(states.size());
@@ -303,11 +304,7 @@ std::vector<ScoreValue> WindowScorer::EvaluateStatesOn(const std::vector<Calibra
   double weight_sum = 0;
   for (size_t f = begin; f < end; ++f) {
     const CalibrationFrame& cf = *frames_[f];
-    const int maps_count = static_cast<int>(cf.score_maps[0].size());
-    const int l = level < 0 ? maps_count + level : level;
-    CHECK(l >= 0 && l < maps_count && l < static_cast<int>(cf.score_maps[1].size()))
-        << "score level " << level << " of " << maps_count;
-    const MapView maps[2] = {MapView(cf.score_maps[0][l]), MapView(cf.score_maps[1][l])};
+    const MapView maps[2] = {MapView(ScoreMapAt(cf, 0, level)), MapView(ScoreMapAt(cf, 1, level))};
     const std::vector<Eigen::Vector3d>& points = points_[f];
     for (size_t k = 0; k < points.size(); ++k) weight_sum += weights_[f][k];
     // As EvaluateOn: h = M·p + b, depth = depth_row·p + depth_offset.
