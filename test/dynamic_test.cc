@@ -508,6 +508,43 @@ TEST(SweepCache, AFinishedSweepIsItsOwnBase) {
   EXPECT_EQ(next->edges.points_lidar, fresh_next->edges.points_lidar);
 }
 
+// A cache that releases the capture fields of finished sweeps (the frame source's) gives every
+// local map of a sequential pass bit for bit as one that keeps them, and its finished sweeps
+// still hold what later sweeps read (de-skewed points, ground, edges) but no scan.
+TEST(SweepCache, ReleasingCaptureFieldsChangesNoLocalMap) {
+  STCALIB_REQUIRE_KITTI();
+  Drive drive;
+  DriveMotion motion;
+  ASSERT_TRUE(testing::OpenKittiDrive(&drive, &motion));
+  SweepCache keeping(drive, motion, LidarFeatureOptions());
+  SweepCache releasing(drive, motion, LidarFeatureOptions());
+  releasing.ReleaseCaptureFieldsOnceFinished();
+  const LocalMapOptions map_options;  // 3 sweeps
+  for (size_t frame = 0; frame < 8; ++frame) {
+    LidarEdges kept_map, released_map;
+    LocalMapStats kept_stats, released_stats;
+    ASSERT_TRUE(keeping.LocalMap(frame, map_options, &kept_map, &kept_stats).ok());
+    ASSERT_TRUE(releasing.LocalMap(frame, map_options, &released_map, &released_stats).ok());
+    ASSERT_GT(kept_map.size(), 0u) << frame;
+    EXPECT_EQ(released_stats.sweeps_used, kept_stats.sweeps_used) << frame;
+    EXPECT_EQ(released_map.points_lidar, kept_map.points_lidar) << frame;
+    EXPECT_EQ(released_map.kind, kept_map.kind) << frame;
+    EXPECT_EQ(released_map.offset_rate, kept_map.offset_rate) << frame;
+    EXPECT_EQ(released_map.fold, kept_map.fold) << frame;
+    EXPECT_EQ(released_map.sweep_age, kept_map.sweep_age) << frame;
+  }
+  const LidarFrameFeatures *kept = nullptr, *released = nullptr;
+  ASSERT_TRUE(keeping.Finished(7, &kept).ok());
+  ASSERT_TRUE(releasing.Finished(7, &released).ok());
+  EXPECT_GT(kept->scan.size(), 0u);
+  EXPECT_EQ(released->scan.size(), 0u);
+  EXPECT_TRUE(released->point_time_s.empty());
+  EXPECT_EQ(released->rings.num_rings(), -1);
+  EXPECT_EQ(released->deskewed, kept->deskewed);
+  EXPECT_EQ(released->ground, kept->ground);
+  EXPECT_EQ(released->dynamic.dynamic, kept->dynamic.dynamic);
+}
+
 // The dynamic filter's range image bins FastAtan2's angles: within 2e-11 rad of std::atan2 over
 // every octant, at the octant borders and the reduction's switch (tan π/8), and within 1e-15 rad
 // with the same sign on the axes and signed zeros.

@@ -174,6 +174,11 @@ Status SweepCache::Finished(size_t frame, const LidarFrameFeatures** features) {
     CHECK(!node.empty() && &node.mapped() == base) << "sweep " << frame << " not in the cache";
     LidarFrameFeatures f = std::move(node.mapped());
     FinishLidarFrameFeatures(references, options_, &f);
+    if (release_capture_fields_) {
+      f.scan = LidarScan();
+      f.rings = ScanRings();
+      f.point_time_s = std::vector<double>();
+    }
     it = finished_.emplace(frame, std::move(f)).first;
     Evict(frame);
     // A backward pass: sweeps more than a capacity after this one are not asked for again soon.

@@ -94,6 +94,11 @@ class SweepCache {
   Status LocalMap(size_t frame, const LocalMapOptions& map_options, LidarEdges* map,
                   LocalMapStats* stats);
   size_t capacity() const { return capacity_; }
+  // From now on a sweep, once finished, gives up what only finishing reads: the scan as read, its
+  // rings and per-point capture times (about 5.5 MB of a 64-beam sweep's 9 MB). Later readers of
+  // a finished entry (the dynamic filter's references, the local map, NDT) read its de-skewed
+  // points, ground mask and edges, which it keeps. For a caller that reads no other field.
+  void ReleaseCaptureFieldsOnceFinished() { release_capture_fields_ = true; }
   size_t cached_sweeps() const { return base_.size() + finished_.size(); }  ///< base + finished
 
  private:
@@ -105,6 +110,7 @@ class SweepCache {
   double sweep_s_;
   size_t long_gap_;  ///< frames back to the long-baseline reference sweep
   size_t capacity_;
+  bool release_capture_fields_ = false;
   std::map<size_t, LidarFrameFeatures> base_, finished_;
 };
 

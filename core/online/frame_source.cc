@@ -12,15 +12,17 @@ namespace {
 
 // A frame stays in the calibrator's window for up to refine_frames frames, and every full-size
 // float map costs width × height × 4 bytes (1.9 MB on KITTI). Of its image features the frame's
-// readers need only what it does not hold itself: the edge count (ImageFeatures::empty), the
-// raw distance map and the edge mask (the overlays). A frame scoring on the band-pass IDTs also
+// readers need only what it does not hold itself: the edge count (ImageFeatures::empty); the
+// overlays read the frame's own distance maps. A frame scoring on the band-pass IDTs also
 // drops the texture-suppressed and plain IDTs, which TextureSuppressedMap and PlainIdt make again
 // from its score and distance maps where they are read (the health check, the gray rate).
 void ReleaseMapsNotRead(double basin_px, CalibrationFrame* frame) {
   ImageFeatures& features = frame->image;
+  features.distance_raw_px.release();
   features.distance_vertical_raw_px.release();
   features.distance_horizontal_raw_px.release();
   features.segments.clear();
+  features.edge_mask.release();
   features.segments.shrink_to_fit();
   if (!frame->score_maps_bandpass) return;
   features.idt_suppressed.release();
@@ -89,6 +91,7 @@ Status DriveFrameSource::Create(const Drive* drive, const FrameSourceOptions& op
   }
   STCALIB_RETURN_IF_ERROR(DriveMotion::CreateForDrive(*drive, &s->motion_));
   s->cache_ = std::make_unique<SweepCache>(*drive, s->motion_, s->options_.lidar);
+  s->cache_->ReleaseCaptureFieldsOnceFinished();  // Load reads local maps only
   *source = std::move(s);
   return Status::Ok();
 }
