@@ -137,6 +137,10 @@ CalibrateJob CalibrateJobFromFlags() {
   CHECK(ImageOptionsFromFlags(&job.source.image).ok()) << FLAGS_detector;
   job.convergence.health_check.min_health = FLAGS_min_health;
   job.convergence.min_final_health = o.lost_health;  // lost is never converged
+  StartUncertainty uncertainty;
+  // CalibrateFlagsError has checked the figures.
+  CHECK(ParseStartUncertainty(FLAGS_init_uncertainty, &uncertainty).ok()) << FLAGS_init_uncertainty;
+  o = ForStartUncertainty(o, uncertainty, job.perturb_time_s);
   return job;
 }
 
@@ -544,6 +548,9 @@ std::string CalibrateFlagsError() {
     RefineOptions::Loss loss;
     if (!ParseLoss(*value, &loss)) return std::string(name) + " must be " + LossChoices();
   }
+  StartUncertainty uncertainty;
+  const Status uncertainty_status = ParseStartUncertainty(FLAGS_init_uncertainty, &uncertainty);
+  if (!uncertainty_status.ok()) return uncertainty_status.message();
   OnlineCalibratorOptions::Folds folds;
   if (!ParseFolds(FLAGS_lidar_folds, &folds)) {
     return "--lidar_folds must be " + FoldsChoices();

@@ -47,6 +47,10 @@ DEFINE_double(
     perturb_time_s, 0.0,
     "calibrate: initial time offset δ0 [s]; check: added to the stored δ (time_offset.txt "
     "beside the checked calib_velo_to_cam.txt, else 0)");
+DEFINE_string(init_uncertainty, "",
+              "calibrate: how far off the start may be on each axis, ROT_DEG,TRANS_M,TIME_S "
+              "(e.g. 5,0.2,0.1): widens the acquisition grid, the bounds and the translation and "
+              "time offset priors to match (empty: the defaults, for about 3 deg, 5 cm, 30 ms)");
 DEFINE_int32(first_frame, 0, "calibrate: first frame used");
 DEFINE_int32(num_frames, 0, "calibrate: frames used (0 = to the end)");
 // Defaults of the tuning flags come from the library's option structs, where the reasons for

@@ -51,8 +51,8 @@ const std::vector<Subcommand>& Subcommands() {
        {"drive", "frame", "out", "calib_dir", "detector"}},
       {"calibrate",
        "--drive=DRIVE_DIR [--calib_dir=DIR] [--init_calib=FILE] [--perturb_rot_deg=D] "
-       "[--perturb_trans_m=M] [--perturb_time_s=S] [--seed=S] [--first_frame=I] [--num_frames=N] "
-       "[--out=DIR] [--flagfile=configs/X.flags]",
+       "[--perturb_trans_m=M] [--perturb_time_s=S] [--init_uncertainty=DEG,M,S] [--seed=S] "
+       "[--first_frame=I] [--num_frames=N] [--out=DIR] [--flagfile=configs/X.flags]",
        "online calibration of rotation, translation and time offset; with --out writes the "
        "estimate, result.json, per_frame.csv and pictures, without it prints the estimate; exit 0 "
        "only when converged",
@@ -66,11 +66,11 @@ const std::vector<Subcommand>& Subcommands() {
         "perturb_rot_deg",
         "perturb_trans_m",
         "perturb_time_s",
+        "init_uncertainty",
         "seed",
         "estimate_time_offset",
         "time_offset_bound_s",
         "prior_sigma_translation_m",
-        "prior_sigma_time_s",
         "window_frames",
         "refine_frames",
         "local_map_sweeps",

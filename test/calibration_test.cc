@@ -337,6 +337,57 @@ TEST(OnlineCalibrator, SharedSettingsReachScoreSearchAndRefine) {
   EXPECT_FALSE(options.Validate().ok());
 }
 
+// --init_uncertainty's figures: parsed with errors naming the text; a start within the defaults
+// leaves every setting as it is, a wider one widens the grid, the bounds (norms over three axes)
+// and the priors to hold it, and the δ bound to reach around δ0.
+TEST(OnlineCalibrator, StartUncertaintyWidensOnlyWhatTheDefaultsDoNotHold) {
+  StartUncertainty u;
+  ASSERT_TRUE(ParseStartUncertainty("", &u).ok());
+  EXPECT_EQ(u.rotation_deg, 0.0);
+  ASSERT_TRUE(ParseStartUncertainty("5,0.2,0.1", &u).ok());
+  EXPECT_EQ(u.rotation_deg, 5.0);
+  EXPECT_EQ(u.translation_m, 0.2);
+  EXPECT_EQ(u.time_offset_s, 0.1);
+  for (const char* bad :
+       {"5,0.2", "5,0.2,0.1,1", "5,,0.1", "5,x,0.1", "-1,0.2,0.1", "5,nan,0.1", "5,0.2,0.1,"}) {
+    const Status status = ParseStartUncertainty(bad, &u);
+    EXPECT_FALSE(status.ok()) << bad;
+    EXPECT_THAT(status.message(), ::testing::HasSubstr(std::string("--init_uncertainty=") + bad));
+  }
+
+  const OnlineCalibratorOptions defaults;
+  StartUncertainty within;
+  within.rotation_deg = 2;
+  within.translation_m = 0.05;
+  within.time_offset_s = 0.03;
+  const OnlineCalibratorOptions same = ForStartUncertainty(defaults, within, 0.0);
+  EXPECT_EQ(same.wide_grid_deg, 0.0);
+  EXPECT_EQ(same.lost_grid_deg, defaults.lost_grid_deg);
+  EXPECT_EQ(same.search.max_rotation_offset_deg, defaults.search.max_rotation_offset_deg);
+  EXPECT_EQ(same.search.max_translation_offset_m, defaults.search.max_translation_offset_m);
+  EXPECT_EQ(same.search.translation_prior_sigma_m, defaults.search.translation_prior_sigma_m);
+  EXPECT_EQ(same.refine.prior_sigma_translation_m, defaults.refine.prior_sigma_translation_m);
+  EXPECT_EQ(same.refine.prior_sigma_time_s, defaults.refine.prior_sigma_time_s);
+  EXPECT_EQ(same.time_offset_bound_s, defaults.time_offset_bound_s);
+
+  const StartUncertainty wide{5, 0.2, 0.1};
+  const OnlineCalibratorOptions widened = ForStartUncertainty(defaults, wide, -0.1);
+  EXPECT_EQ(widened.wide_grid_deg, 6.0);  // the start's error plus the peak's basin
+  EXPECT_EQ(widened.lost_grid_deg, defaults.lost_grid_deg);
+  // A truth 5° off on each axis, 0.2 m on each, and δ 0.1 s beyond δ0 lies inside the bounds.
+  CalibrationState start;
+  CalibrationState truth =
+      Step(start, Eigen::Vector3d(5, -5, 5) * M_PI / 180.0, Eigen::Vector3d(0.2, -0.2, 0.2), -0.2);
+  start.time_offset_s = -0.1;
+  EXPECT_FALSE(WithinBounds(truth, start, defaults.search));
+  EXPECT_TRUE(WithinBounds(truth, start, WithSharedSettings(widened).search));
+  EXPECT_EQ(widened.refine.prior_sigma_translation_m, 0.2);
+  EXPECT_EQ(widened.search.translation_prior_sigma_m, 0.2);
+  EXPECT_EQ(widened.refine.prior_sigma_time_s, 0.1);
+  EXPECT_EQ(widened.search.time_offset_prior_sigma_s, 0.1);
+  EXPECT_TRUE(widened.Validate().ok());
+}
+
 TEST(Calibration, StagesAgainstSimulatedTruth) {
   testing::ScopedTempDir tmp;
   sim::SimulatorOptions sim_options;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iterator>
 #include <limits>
 #include <optional>
@@ -49,6 +50,9 @@ Status OnlineCalibratorOptions::Validate() const {
     return Status::Error("online: refined_score_tolerance must be in [0, 1)");
   }
   if (refine_map_sweeps < 0) return Status::Error("online: refine_map_sweeps must be >= 0");
+  if (!(wide_grid_deg >= 0) || wide_grid_agreement_frames < 1) {
+    return Status::Error("online: wide_grid_deg must be >= 0 and wide_grid_agreement_frames >= 1");
+  }
   if (!(tracking_max_lag_deg >= 0)) {
     return Status::Error("online: tracking_max_lag_deg must be >= 0");
   }
@@ -120,6 +124,63 @@ OnlineCalibratorOptions WithSharedSettings(const OnlineCalibratorOptions& option
   return out;
 }
 
+Status ParseStartUncertainty(const std::string& text, StartUncertainty* uncertainty) {
+  *uncertainty = StartUncertainty();
+  if (text.empty()) return Status::Ok();
+  const std::string what = "--init_uncertainty=" + text + ": ";
+  std::vector<double> figures;
+  size_t begin = 0;
+  while (begin <= text.size()) {
+    const size_t end = std::min(text.find(',', begin), text.size());
+    const std::string field = text.substr(begin, end - begin);
+    char* stop = nullptr;
+    const double value = std::strtod(field.c_str(), &stop);
+    if (field.empty() || stop != field.c_str() + field.size() || !std::isfinite(value) ||
+        value < 0) {
+      return Status::Error(what + "\"" + field +
+                           "\" is not a non-negative number (expected ROT_DEG,TRANS_M,TIME_S)");
+    }
+    figures.push_back(value);
+    begin = end + 1;
+  }
+  if (figures.size() != 3) {
+    return Status::Error(what + "expected three figures ROT_DEG,TRANS_M,TIME_S, got " +
+                         std::to_string(figures.size()));
+  }
+  uncertainty->rotation_deg = figures[0];
+  uncertainty->translation_m = figures[1];
+  uncertainty->time_offset_s = figures[2];
+  return Status::Ok();
+}
+
+OnlineCalibratorOptions ForStartUncertainty(const OnlineCalibratorOptions& options,
+                                            const StartUncertainty& uncertainty,
+                                            double initial_time_offset_s) {
+  OnlineCalibratorOptions out = options;
+  const double rotation_deg = std::max(0.0, uncertainty.rotation_deg);
+  const double translation_m = std::max(0.0, uncertainty.translation_m);
+  const double time_s = std::max(0.0, uncertainty.time_offset_s);
+  constexpr double kBasinDeg = 1.0;  // the band-pass score's peak, docs/method.md §10
+  if (out.lost_grid_deg > 0 && rotation_deg + kBasinDeg > out.lost_grid_deg) {
+    out.wide_grid_deg = std::max(out.wide_grid_deg, rotation_deg + kBasinDeg);
+  }
+  // The bounds are norms over the three axes.
+  const double kAxes = std::sqrt(3.0);
+  out.search.max_rotation_offset_deg =
+      std::max(out.search.max_rotation_offset_deg, kAxes * rotation_deg + kBasinDeg);
+  out.search.max_translation_offset_m =
+      std::max(out.search.max_translation_offset_m, kAxes * translation_m + 0.05);
+  out.search.translation_prior_sigma_m =
+      std::max(out.search.translation_prior_sigma_m, translation_m);
+  out.refine.prior_sigma_translation_m =
+      std::max(out.refine.prior_sigma_translation_m, translation_m);
+  out.search.time_offset_prior_sigma_s = std::max(out.search.time_offset_prior_sigma_s, time_s);
+  out.refine.prior_sigma_time_s = std::max(out.refine.prior_sigma_time_s, time_s);
+  out.time_offset_bound_s =
+      std::max(out.time_offset_bound_s, std::abs(initial_time_offset_s) + time_s);
+  return out;
+}
+
 OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
                                    const CalibrationState& initial)
     : options_(WithSharedSettings(options)), state_(initial) {
@@ -127,6 +188,8 @@ OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
   state_.time_offset_s =
       std::clamp(state_.time_offset_s, -options_.time_offset_bound_s, options_.time_offset_bound_s);
   anchor_ = state_;
+  grid_center_rotation_ = state_.T_camera_lidar.linear();
+  grid_narrowed_ = !(options_.wide_grid_deg > options_.lost_grid_deg);
   frames_since_update_ = options_.tracking_update_every;
   OnlineCalibratorOptions fold_free = options_;
   fold_free.horizontal_weight = options_.tracking_horizontal_weight;
@@ -448,12 +511,15 @@ void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
   bool grid_agrees = false;
   if ((report->coarse_search || was_acquiring) && options_.lost_grid_deg > 0) {
     // Rotations around the initial calibration's (the truth lies within the start's error of
-    // it, whatever side peak the estimate may have climbed since), with the estimate's
-    // translation and δ (a stale δ or translation would shift the grid's best rotation).
+    // it, whatever side peak the estimate may have climbed since) or the wide stage's result,
+    // with the estimate's translation and δ (a stale δ or translation would shift the grid's
+    // best rotation).
     CalibrationState centre = state_;
-    centre.T_camera_lidar.linear() = anchor_.T_camera_lidar.linear();
+    centre.T_camera_lidar.linear() = grid_center_rotation_;
+    const bool wide = !grid_narrowed_;
     const RotationGridResult grid =
-        RotationGridSearch(long_scorer, centre, anchor_, *search_options, options_.lost_grid_deg,
+        RotationGridSearch(long_scorer, centre, anchor_, *search_options,
+                           wide ? options_.wide_grid_deg : options_.lost_grid_deg,
                            options_.lost_grid_step_deg, -1, &grid_cache_);
     grid_evaluations = grid.evaluations;
     // Agreement: the estimate is within one lattice step (diagonals included) of the grid's
@@ -461,8 +527,15 @@ void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
     const double grid_offset_deg =
         RotationErrorDeg(grid.state.T_camera_lidar.linear(), state_.T_camera_lidar.linear());
     grid_agrees = grid_offset_deg < std::sqrt(3.0) * options_.lost_grid_step_deg + 1e-6;
-    VLOG(1) << "frame " << report->frame << ": rotation grid best " << grid_offset_deg
-            << " deg from the estimate over " << long_scorer->num_frames() << " frames";
+    VLOG(1) << "frame " << report->frame << ": " << (wide ? "wide " : "") << "rotation grid best "
+            << grid_offset_deg << " deg from the estimate over " << long_scorer->num_frames()
+            << " frames";
+    if (wide && grid_agrees &&
+        static_cast<int>(long_scorer->num_frames()) >= options_.wide_grid_agreement_frames) {
+      grid_narrowed_ = true;
+      grid_center_rotation_ = grid.state.T_camera_lidar.linear();
+      grid_agrees = false;  // the narrow grid's agreement ends an acquisition, not the wide one's
+    }
     search_start = grid.state;
     search_options->first_level = scorer->num_levels() - 1;
     // δ while acquiring: the whole bounded range at the grid's rotation. The local search moves δ

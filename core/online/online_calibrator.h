@@ -79,6 +79,12 @@ struct OnlineCalibratorOptions {
   // (about ±1°) but global: a ±3° grid finds it.
   double lost_grid_deg = 3.0;
   double lost_grid_step_deg = 0.5;
+  // A start farther off than ±lost_grid_deg (ForStartUncertainty sets it): the acquisition's first
+  // grids span ±wide_grid_deg around the start [deg]; once one agrees with the estimate on
+  // wide_grid_agreement_frames frames, every later grid (acquiring or lost) spans ±lost_grid_deg
+  // around that grid's best rotation. 0 = no wide stage (the grids stay around the start).
+  double wide_grid_deg = 0;
+  int wide_grid_agreement_frames = 5;
   // Acquisition: from the start, the grid runs on every frame (not only when lost) until, on a
   // full refinement window, its best point agrees with the estimate within one grid step (on
   // each axis; √3 steps in all). A few frames can have their global optimum far off; the frames a
@@ -232,6 +238,25 @@ CalibrationState KeepObservableAxes(const CalibrationState& old, const Calibrati
 // (horizontal_weight, time_offset_bound_s) copied into score, search and refine: the options an
 // OnlineCalibrator runs with. Use it to run a stage alone with the calibrator's settings.
 OnlineCalibratorOptions WithSharedSettings(const OnlineCalibratorOptions& options);
+
+// What the user knows of the start (`stcalib calibrate --init_uncertainty`): each axis of the
+// initial calibration may be off by up to these figures.
+struct StartUncertainty {
+  double rotation_deg = 0;   ///< per axis (roll, pitch, yaw) [deg]
+  double translation_m = 0;  ///< per axis (x, y, z) [m]
+  double time_offset_s = 0;  ///< δ0's error [s]
+};
+// "ROT_DEG,TRANS_M,TIME_S" (three non-negative numbers; empty: all zero), else an error naming
+// the text and what is wrong with it.
+Status ParseStartUncertainty(const std::string& text, StartUncertainty* uncertainty);
+// `options` widened for a start that far off, never narrowed (a zero figure leaves its settings;
+// the defaults hold a start within about ±3°, ±5 cm and ±30 ms): the acquisition grid covers the
+// rotation error plus a basin (lost_grid_deg), the search's bounds hold the truth, and the
+// translation and δ priors (whose σ the verdict's translation rule reads) are at least as wide
+// as the start's error. `initial_time_offset_s`: δ0, around which the δ bound must reach.
+OnlineCalibratorOptions ForStartUncertainty(const OnlineCalibratorOptions& options,
+                                            const StartUncertainty& uncertainty,
+                                            double initial_time_offset_s);
 
 class OnlineCalibrator {
  public:
@@ -394,6 +419,9 @@ class OnlineCalibrator {
   // The rotation grid's per-frame scores: while acquiring the grid runs on a window that grows
   // by one frame, and each frame is scored once as long as the translation and δ stay put.
   RotationGridCache grid_cache_;
+  // The grids' centre: the start's rotation, or the wide stage's result once it narrowed.
+  Eigen::Matrix3d grid_center_rotation_;
+  bool grid_narrowed_ = true;      ///< no wide stage, or it has ended
   HealthScoreCache health_cache_;  // the estimate's health, frame by frame
   double last_camera_time_s_ = -std::numeric_limits<double>::infinity();
 };
