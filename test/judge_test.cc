@@ -66,7 +66,7 @@ std::string FirstFailure(const ConvergenceEvidence& e,
 TEST(Judge, EvidenceThatPassesEveryRuleConverges) {
   EXPECT_EQ(FirstFailure(Passing()), "");
   const std::vector<std::string> names = ConvergenceRuleNames();
-  ASSERT_EQ(names.size(), 14u);
+  ASSERT_EQ(names.size(), 15u);
   EXPECT_EQ(names.front(), "frames_used");
   EXPECT_EQ(names.back(), kSuppressedCheckRule);
 }
@@ -125,6 +125,19 @@ TEST(Judge, EachRuleRefusesItsOwnFailure) {
   e.translation_move_m.y() = -0.11;  // beyond 2 × 5 cm
   EXPECT_EQ(FirstFailure(e), "translation_within_prior");
   EXPECT_NE(Judge(e, {}).reason.find("-11.0 cm from the start on y_m"), std::string::npos);
+
+  // Windows 15 cm apart across travel (y, with travel along z) fail; along travel they may.
+  e = Passing();
+  e.along_travel_axis = 2;
+  e.translation_spread_m = Eigen::Vector3d(0.03, 0.149, 0.5);
+  EXPECT_EQ(FirstFailure(e), "translation_spread");
+  EXPECT_NE(Judge(e, {}).reason.find("spread 14.9 cm on y_m"), std::string::npos);
+  e.translation_spread_m.y() = 0.07;
+  EXPECT_EQ(FirstFailure(e), "");
+  ConvergenceOptions no_limit;
+  no_limit.max_translation_spread_m = 0;
+  e.translation_spread_m.y() = 0.3;
+  EXPECT_EQ(FirstFailure(e, no_limit), "");
 
   e = Passing();
   e.final_health = 0.85;

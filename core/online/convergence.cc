@@ -9,6 +9,9 @@
 namespace stcalib {
 
 Status ConvergenceOptions::Validate() const {
+  if (!(max_translation_spread_m >= 0)) {
+    return Status::Error("convergence: max_translation_spread_m must be >= 0 (0 = no limit)");
+  }
   if (!(max_translation_move_sigmas >= 0)) {
     return Status::Error("convergence: max_translation_move_sigmas must be >= 0 (0 = no limit)");
   }
@@ -190,6 +193,22 @@ RuleOutcome TranslationWithinPrior(const ConvergenceEvidence& e, const Convergen
                      o.max_translation_move_sigmas, 100 * e.prior_sigma_translation_m)};
 }
 
+RuleOutcome TranslationSpread(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
+  int widest = -1;
+  for (int i = 0; i < 3; ++i) {
+    if (i == e.along_travel_axis) continue;
+    if (widest < 0 || e.translation_spread_m[i] > e.translation_spread_m[widest]) widest = i;
+  }
+  const double spread_m = e.translation_spread_m[widest];
+  const std::string text = Format("%.1f cm on ", 100 * spread_m) + kAxisNames[3 + widest];
+  if (!(o.max_translation_spread_m > 0) || spread_m <= o.max_translation_spread_m) {
+    return {"translation_spread", true, "the windows' translations across travel spread " + text};
+  }
+  return {"translation_spread", false,
+          "the windows' refinements do not pin the translation down across travel: they spread " +
+              text + Format(" (more than %.1f cm)", 100 * o.max_translation_spread_m)};
+}
+
 RuleOutcome Health(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
   const std::string text = Format("health %.3f ", e.final_health) +
                            (e.final_health < o.min_final_health ? "<" : ">=") +
@@ -238,10 +257,21 @@ RuleOutcome SuppressedCheck(const ConvergenceEvidence& e, const ConvergenceOptio
   return {kSuppressedCheckRule, h.decided && h.holds, text};
 }
 
-constexpr Rule kRules[] = {
-    FramesUsed,   Features,   Updated,          EnoughFrames,          Acquired,
-    InsideBounds, Observable, RotationProfiles, TimeOffsetProfileRule, TranslationWithinPrior,
-    Health,       Settled,    Jackknife,        SuppressedCheck};
+constexpr Rule kRules[] = {FramesUsed,
+                           Features,
+                           Updated,
+                           EnoughFrames,
+                           Acquired,
+                           InsideBounds,
+                           Observable,
+                           RotationProfiles,
+                           TimeOffsetProfileRule,
+                           TranslationWithinPrior,
+                           TranslationSpread,
+                           Health,
+                           Settled,
+                           Jackknife,
+                           SuppressedCheck};
 
 }  // namespace
 
@@ -366,6 +396,10 @@ ConvergenceEvidence GatherEvidence(const OnlineCalibrator& calibrator,
   e.translation_move_m =
       verdict->estimate.T_camera_lidar.translation() - initial.T_camera_lidar.translation();
   e.prior_sigma_translation_m = online.refine.prior_sigma_translation_m;
+  e.translation_spread_m = verdict->refinement_spread_m;
+  const Eigen::Vector3d forward = last_update.refine.forward_camera;
+  if (forward.allFinite() && forward.squaredNorm() > 0)
+    forward.cwiseAbs().maxCoeff(&e.along_travel_axis);
   e.final_health = last.health;
   return e;
 }

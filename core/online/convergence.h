@@ -44,6 +44,11 @@ struct ConvergenceOptions {
   // The spread of the window refinements about the estimate (ConvergenceVerdict::
   // refinement_spread_m) is taken over the last this many updates with a usable refinement.
   int spread_updates = 10;
+  // ... and across the direction of travel it must stay under this [m] (0 = no limit): windows
+  // that put the translation this far apart have not pinned it down, and the rotation that
+  // compensates it is off too (a wide start on a drive whose score peak is off:
+  // docs/results.md#wide-start). Claimed runs of the development suite spread up to 7 cm.
+  double max_translation_spread_m = 0.1;
   // An independent check of the estimate on the texture-suppressed maps of the last
   // `check_frames` frames (windows of HealthCheckOptions::window_frames): foliage makes a plain
   // map's optimum degrees off look healthy, the suppressed maps do not.
@@ -77,6 +82,10 @@ struct ConvergenceEvidence {
   TimeOffsetProfile time_offset_profile;
   Eigen::Vector3d translation_move_m = Eigen::Vector3d::Zero();  ///< estimate − start, camera
   double prior_sigma_translation_m = 0;                          ///< the translation prior's σ [m]
+  // The window refinements' spread about the estimate (ConvergenceVerdict::refinement_spread_m)
+  // on each translation axis, and the axis the direction of travel lies most along (-1: none).
+  Eigen::Vector3d translation_spread_m = Eigen::Vector3d::Zero();
+  int along_travel_axis = -1;
   double final_health = 0;  ///< health at the estimate on the last window
   double settle_deg = 0;    ///< the farthest estimate of the last settle_frames updates [deg]
   // The rotation's block jackknife over the refinement's frames (JackknifeRotation, blocks of the
