@@ -508,16 +508,19 @@ TEST(SweepCache, AFinishedSweepIsItsOwnBase) {
   EXPECT_EQ(next->edges.points_lidar, fresh_next->edges.points_lidar);
 }
 
-// A cache that releases the capture fields of finished sweeps (the frame source's) gives every
-// local map of a sequential pass bit for bit as one that keeps them, and its finished sweeps
-// still hold what later sweeps read (de-skewed points, ground, edges) but no scan.
+// A cache that releases the capture fields of finished sweeps and holds the least capacity (the
+// frame source's) gives every local map of a sequential pass bit for bit as one that keeps them,
+// and its finished sweeps still hold what later sweeps read (de-skewed points, ground, edges) but
+// no scan.
 TEST(SweepCache, ReleasingCaptureFieldsChangesNoLocalMap) {
   STCALIB_REQUIRE_KITTI();
   Drive drive;
   DriveMotion motion;
   ASSERT_TRUE(testing::OpenKittiDrive(&drive, &motion));
   SweepCache keeping(drive, motion, LidarFeatureOptions());
-  SweepCache releasing(drive, motion, LidarFeatureOptions());
+  // The least capacity (the frame source's) holds a sequential pass's local maps and long-baseline
+  // references: every sweep is read once.
+  SweepCache releasing(drive, motion, LidarFeatureOptions(), /*capacity=*/0);
   releasing.ReleaseCaptureFieldsOnceFinished();
   const LocalMapOptions map_options;  // 3 sweeps
   for (size_t frame = 0; frame < 8; ++frame) {
@@ -533,6 +536,8 @@ TEST(SweepCache, ReleasingCaptureFieldsChangesNoLocalMap) {
     EXPECT_EQ(released_map.fold, kept_map.fold) << frame;
     EXPECT_EQ(released_map.sweep_age, kept_map.sweep_age) << frame;
   }
+  EXPECT_EQ(releasing.sweeps_loaded(), 8u);
+  EXPECT_LT(releasing.capacity(), keeping.capacity());
   const LidarFrameFeatures *kept = nullptr, *released = nullptr;
   ASSERT_TRUE(keeping.Finished(7, &kept).ok());
   ASSERT_TRUE(releasing.Finished(7, &released).ok());

@@ -125,6 +125,7 @@ Status SweepCache::Base(size_t frame, const LidarFrameFeatures** features) {
     STCALIB_RETURN_IF_ERROR(drive_.LoadScan(frame, &scan));
     if (scan.size() == 0) LOG(WARNING) << drive_.VelodynePath(frame) << ": empty sweep";
     const double stamp = motion_.Seconds(drive_.lidar_stamps_ns[frame]);
+    ++sweeps_loaded_;
     it = base_
              .emplace(frame, ComputeLidarSweepBase(std::move(scan), stamp, sweep_s_,
                                                    motion_.PoseFunction(), options_))

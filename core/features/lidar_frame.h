@@ -100,6 +100,7 @@ class SweepCache {
   // points, ground mask and edges, which it keeps. For a caller that reads no other field.
   void ReleaseCaptureFieldsOnceFinished() { release_capture_fields_ = true; }
   size_t cached_sweeps() const { return base_.size() + finished_.size(); }  ///< base + finished
+  size_t sweeps_loaded() const { return sweeps_loaded_; }  ///< sweeps read and based so far
 
  private:
   void Evict(size_t newest);
@@ -111,6 +112,7 @@ class SweepCache {
   size_t long_gap_;  ///< frames back to the long-baseline reference sweep
   size_t capacity_;
   bool release_capture_fields_ = false;
+  size_t sweeps_loaded_ = 0;
   std::map<size_t, LidarFrameFeatures> base_, finished_;
 };
 

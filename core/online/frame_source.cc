@@ -90,7 +90,9 @@ Status DriveFrameSource::Create(const Drive* drive, const FrameSourceOptions& op
     s->options_.lidar.dynamic.roi_half_angle_deg = window.y();
   }
   STCALIB_RETURN_IF_ERROR(DriveMotion::CreateForDrive(*drive, &s->motion_));
-  s->cache_ = std::make_unique<SweepCache>(*drive, s->motion_, s->options_.lidar);
+  // A sequential pass needs the local map's sweeps and the dynamic filter's long-baseline
+  // reference, which the cache's least capacity holds: no more (each sweep kept costs ~4 MB).
+  s->cache_ = std::make_unique<SweepCache>(*drive, s->motion_, s->options_.lidar, /*capacity=*/0);
   s->cache_->ReleaseCaptureFieldsOnceFinished();  // Load reads local maps only
   *source = std::move(s);
   return Status::Ok();
