@@ -21,6 +21,9 @@ bool RetainFreedHeapMemory() {
     // A fixed trim threshold would also fix the mmap threshold at its 128 KiB default.
     return false;
   }
+  // One arena for every thread: what the frame loader's thread frees (a frame leaving the window)
+  // serves the calibrating thread's next blocks too, so the two threads' peaks do not add up.
+  mallopt(M_ARENA_MAX, 1);
   return mallopt(M_TRIM_THRESHOLD, kTrimThresholdBytes) == 1;
 #else
   return false;
