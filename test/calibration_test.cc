@@ -362,6 +362,7 @@ TEST(OnlineCalibrator, StartUncertaintyWidensOnlyWhatTheDefaultsDoNotHold) {
   within.time_offset_s = 0.03;
   const OnlineCalibratorOptions same = ForStartUncertainty(defaults, within, 0.0);
   EXPECT_EQ(same.wide_grid_deg, 0.0);
+  EXPECT_EQ(same.wide_time_offset_s, 0.0);
   EXPECT_EQ(same.lost_grid_deg, defaults.lost_grid_deg);
   EXPECT_EQ(same.search.max_rotation_offset_deg, defaults.search.max_rotation_offset_deg);
   EXPECT_EQ(same.search.max_translation_offset_m, defaults.search.max_translation_offset_m);
@@ -372,7 +373,8 @@ TEST(OnlineCalibrator, StartUncertaintyWidensOnlyWhatTheDefaultsDoNotHold) {
 
   const StartUncertainty wide{5, 0.2, 0.1};
   const OnlineCalibratorOptions widened = ForStartUncertainty(defaults, wide, -0.1);
-  EXPECT_EQ(widened.wide_grid_deg, 6.0);  // the start's error plus the peak's basin
+  EXPECT_EQ(widened.wide_grid_deg, 6.0);       // the start's error plus the peak's basin
+  EXPECT_EQ(widened.wide_time_offset_s, 0.1);  // the wide grids also at δ0 ± 50 and ± 100 ms
   EXPECT_EQ(widened.lost_grid_deg, defaults.lost_grid_deg);
   // A truth 5° off on each axis, 0.2 m on each, and δ 0.1 s beyond δ0 lies inside the bounds.
   CalibrationState start;

@@ -878,9 +878,10 @@ TEST(Cli, SimulatedDriveMeetsTheAcceptance) {
 }
 
 // A start ±5° on each axis, ±20 cm and δ0 100 ms off (issue 55's wide start): with
-// --init_uncertainty saying so, the acquisition's first grids span ±6° around the start and the
-// priors and bounds widen; the run claims, within 0.3° and 5 cm across travel. The same start
-// without it claims nothing. Measured on this drive: 0.119°, x −0.4 cm, y +0.5 cm, δ −2.5 ms.
+// --init_uncertainty saying so, the acquisition's first grids span ±6° around the start at six δ
+// and the priors and bounds widen; the run claims, within 0.3° and 5 cm across travel. The same
+// start without it claims nothing. Measured on this drive: 0.173°, x −0.4 cm, y +1.3 cm,
+// δ −3.0 ms.
 TEST(Cli, CalibratesFromAWideStartWhenToldItsUncertainty) {
   testing::ScopedTempDir tmp;
   const std::string drive =

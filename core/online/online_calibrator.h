@@ -85,6 +85,8 @@ struct OnlineCalibratorOptions {
   // around that grid's best rotation. 0 = no wide stage (the grids stay around the start).
   double wide_grid_deg = 0;
   int wide_grid_agreement_frames = 5;
+  // The wide grids also run at δ0 ± this and ± half of it [s] (0 = at the estimate's δ only).
+  double wide_time_offset_s = 0;
   // Acquisition: from the start, the grid runs on every frame (not only when lost) until, on a
   // full refinement window, its best point agrees with the estimate within one grid step (on
   // each axis; √3 steps in all). A few frames can have their global optimum far off; the frames a
