@@ -1,0 +1,277 @@
+#include "core/io/ros_messages.h"
+
+#include <cmath>
+#include <cstring>
+#include <opencv2/imgproc.hpp>
+
+namespace stcalib {
+namespace {
+
+// Reads CDR fields in order; the first failure sticks, and every later read fails too.
+class Cdr {
+ public:
+  explicit Cdr(const std::vector<uint8_t>& bytes) : bytes_(bytes) {
+    // Encapsulation: 0x00 0x00 big endian CDR, 0x00 0x01 little endian; two option bytes.
+    ok_ = bytes.size() >= 4 && bytes[0] == 0 && (bytes[1] == 0 || bytes[1] == 1);
+    little_ = ok_ && bytes[1] == 1;
+    at_ = 4;
+  }
+  bool ok() const { return ok_; }
+  template <typename T>
+  T Get() {
+    T value{};
+    if (!ok_) return value;
+    at_ = 4 + ((at_ - 4 + sizeof(T) - 1) / sizeof(T)) * sizeof(T);  // align to the size
+    if (at_ > bytes_.size() || sizeof(T) > bytes_.size() - at_) {
+      ok_ = false;
+      return value;
+    }
+    uint8_t raw[sizeof(T)];
+    for (size_t k = 0; k < sizeof(T); ++k) {
+      raw[k] = bytes_[at_ + (little_ ? k : sizeof(T) - 1 - k)];
+    }
+    std::memcpy(&value, raw, sizeof(T));
+    at_ += sizeof(T);
+    return value;
+  }
+  std::string String() {
+    const uint32_t n = Get<uint32_t>();  // with the terminating NUL
+    if (!ok_ || n > bytes_.size() - at_) {
+      ok_ = false;
+      return "";
+    }
+    std::string s(reinterpret_cast<const char*>(bytes_.data() + at_), n > 0 ? n - 1 : 0);
+    at_ += n;
+    return s;
+  }
+  std::vector<uint8_t> Bytes() {
+    const uint32_t n = Get<uint32_t>();
+    if (!ok_ || n > bytes_.size() - at_) {
+      ok_ = false;
+      return {};
+    }
+    std::vector<uint8_t> out(bytes_.begin() + at_, bytes_.begin() + at_ + n);
+    at_ += n;
+    return out;
+  }
+  // std_msgs/msg/Header: builtin_interfaces/Time (int32 sec, uint32 nanosec), frame_id.
+  void Header(int64_t* stamp_ns, std::string* frame_id) {
+    const int32_t sec = Get<int32_t>();
+    const uint32_t nanosec = Get<uint32_t>();
+    *stamp_ns = int64_t{sec} * 1000000000 + nanosec;
+    *frame_id = String();
+  }
+
+ private:
+  const std::vector<uint8_t>& bytes_;
+  bool ok_ = false, little_ = true;
+  size_t at_ = 0;
+};
+
+Status Truncated(const std::string& type) {
+  return Status::Error(type + ": the CDR bytes end before the message does (or bad encapsulation)");
+}
+
+size_t DatatypeBytes(uint8_t datatype) {
+  switch (datatype) {
+    case 1:
+    case 2:
+      return 1;
+    case 3:
+    case 4:
+      return 2;
+    case 5:
+    case 6:
+    case 7:
+      return 4;
+    case 8:
+      return 8;
+    default:
+      return 0;
+  }
+}
+
+// One field's value of the point at `p` as a double; integers as they are.
+double FieldValue(const uint8_t* p, uint8_t datatype, bool big_endian) {
+  uint8_t raw[8];
+  const size_t n = DatatypeBytes(datatype);
+  for (size_t k = 0; k < n; ++k) raw[k] = p[big_endian ? n - 1 - k : k];
+  auto as = [&](auto value) {
+    std::memcpy(&value, raw, sizeof(value));
+    return static_cast<double>(value);
+  };
+  switch (datatype) {
+    case 1:
+      return as(int8_t{});
+    case 2:
+      return as(uint8_t{});
+    case 3:
+      return as(int16_t{});
+    case 4:
+      return as(uint16_t{});
+    case 5:
+      return as(int32_t{});
+    case 6:
+      return as(uint32_t{});
+    case 7:
+      return as(float{});
+    default:
+      return as(double{});
+  }
+}
+
+}  // namespace
+
+Status DecodeImage(const std::vector<uint8_t>& cdr, RosImage* image) {
+  Cdr in(cdr);
+  *image = RosImage();
+  in.Header(&image->stamp_ns, &image->frame_id);
+  image->height = in.Get<uint32_t>();
+  image->width = in.Get<uint32_t>();
+  image->encoding = in.String();
+  image->big_endian = in.Get<uint8_t>() != 0;
+  image->step = in.Get<uint32_t>();
+  image->data = in.Bytes();
+  if (!in.ok()) return Truncated("sensor_msgs/msg/Image");
+  if (uint64_t{image->step} * image->height > image->data.size()) {
+    return Status::Error("sensor_msgs/msg/Image: " + std::to_string(image->height) + " rows of " +
+                         std::to_string(image->step) + " bytes need more than its " +
+                         std::to_string(image->data.size()) + " data bytes");
+  }
+  return Status::Ok();
+}
+
+Status ImageToBgr(const RosImage& image, cv::Mat* bgr) {
+  const int rows = static_cast<int>(image.height), cols = static_cast<int>(image.width);
+  auto view = [&](int type, int channel_bytes) -> Status {
+    if (uint64_t{image.width} * channel_bytes > image.step) {
+      return Status::Error("sensor_msgs/msg/Image: step " + std::to_string(image.step) +
+                           " is shorter than a row of " + image.encoding);
+    }
+    const cv::Mat m(rows, cols, type, const_cast<uint8_t*>(image.data.data()), image.step);
+    if (image.encoding == "bgr8") {
+      *bgr = m.clone();
+    } else if (image.encoding == "rgb8") {
+      cv::cvtColor(m, *bgr, cv::COLOR_RGB2BGR);
+    } else if (image.encoding == "mono8") {
+      cv::cvtColor(m, *bgr, cv::COLOR_GRAY2BGR);
+    } else {  // mono16, in the host's byte order once swapped
+      cv::Mat wide = m.clone();
+      if (image.big_endian) {
+        for (int r = 0; r < rows; ++r) {
+          uint16_t* row = wide.ptr<uint16_t>(r);
+          for (int c = 0; c < cols; ++c)
+            row[c] = static_cast<uint16_t>((row[c] >> 8) | (row[c] << 8));
+        }
+      }
+      cv::Mat narrow;
+      wide.convertTo(narrow, CV_8U, 1.0 / 256);
+      cv::cvtColor(narrow, *bgr, cv::COLOR_GRAY2BGR);
+    }
+    return Status::Ok();
+  };
+  if (image.encoding == "bgr8" || image.encoding == "rgb8") return view(CV_8UC3, 3);
+  if (image.encoding == "mono8") return view(CV_8UC1, 1);
+  if (image.encoding == "mono16") return view(CV_16UC1, 2);
+  return Status::Error("sensor_msgs/msg/Image: encoding \"" + image.encoding +
+                       "\" is not supported (rgb8, bgr8, mono8, mono16)");
+}
+
+Status DecodePointCloud2(const std::vector<uint8_t>& cdr, RosPointCloud* cloud) {
+  Cdr in(cdr);
+  *cloud = RosPointCloud();
+  in.Header(&cloud->stamp_ns, &cloud->frame_id);
+  cloud->height = in.Get<uint32_t>();
+  cloud->width = in.Get<uint32_t>();
+  const uint32_t fields = in.Get<uint32_t>();
+  for (uint32_t k = 0; in.ok() && k < fields; ++k) {
+    RosPointField f;
+    f.name = in.String();
+    f.offset = in.Get<uint32_t>();
+    f.datatype = in.Get<uint8_t>();
+    f.count = in.Get<uint32_t>();
+    cloud->fields.push_back(f);
+  }
+  cloud->big_endian = in.Get<uint8_t>() != 0;
+  cloud->point_step = in.Get<uint32_t>();
+  cloud->row_step = in.Get<uint32_t>();
+  cloud->data = in.Bytes();
+  cloud->dense = in.Get<uint8_t>() != 0;
+  if (!in.ok()) return Truncated("sensor_msgs/msg/PointCloud2");
+  return Status::Ok();
+}
+
+Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* out) {
+  *out = CloudPoints();
+  const std::string type = "sensor_msgs/msg/PointCloud2";
+  auto find = [&](const std::string& name) -> const RosPointField* {
+    for (const RosPointField& f : cloud.fields) {
+      if (f.name == name) return &f;
+    }
+    return nullptr;
+  };
+  const RosPointField* xyz[3] = {find("x"), find("y"), find("z")};
+  for (int a = 0; a < 3; ++a) {
+    if (xyz[a] == nullptr) {
+      return Status::Error(type + ": no field \"" + std::string(1, "xyz"[a]) + "\"");
+    }
+  }
+  const RosPointField* intensity = find("intensity");
+  const RosPointField* ring = find("ring");
+  const RosPointField* time = nullptr;
+  for (const char* name : {"time", "t", "timestamp"}) {
+    if (time == nullptr && (time = find(name)) != nullptr) out->time_field = name;
+  }
+  for (const RosPointField* f : {xyz[0], xyz[1], xyz[2], intensity, ring, time}) {
+    if (f == nullptr) continue;
+    const size_t n = DatatypeBytes(f->datatype);
+    if (n == 0 || uint64_t{f->offset} + n > cloud.point_step) {
+      return Status::Error(type + ": field \"" + f->name + "\" (datatype " +
+                           std::to_string(f->datatype) + " at offset " + std::to_string(f->offset) +
+                           ") does not fit a point of " + std::to_string(cloud.point_step) +
+                           " bytes");
+    }
+  }
+  const uint64_t count = uint64_t{cloud.width} * cloud.height;
+  if (cloud.point_step == 0 || count * cloud.point_step > cloud.data.size() ||
+      uint64_t{cloud.row_step} * cloud.height > cloud.data.size() ||
+      cloud.row_step < uint64_t{cloud.width} * cloud.point_step) {
+    return Status::Error(type + ": " + std::to_string(cloud.height) + " × " +
+                         std::to_string(cloud.width) + " points of " +
+                         std::to_string(cloud.point_step) + " bytes (rows of " +
+                         std::to_string(cloud.row_step) + ") do not fit its " +
+                         std::to_string(cloud.data.size()) + " data bytes");
+  }
+  const double stamp_s = 1e-9 * static_cast<double>(cloud.stamp_ns);
+  const bool integer_time = time != nullptr && time->datatype <= 6;
+  for (uint32_t r = 0; r < cloud.height; ++r) {
+    for (uint32_t c = 0; c < cloud.width; ++c) {
+      const uint8_t* p =
+          cloud.data.data() + uint64_t{r} * cloud.row_step + uint64_t{c} * cloud.point_step;
+      Eigen::Vector3d point;
+      for (int a = 0; a < 3; ++a) {
+        point[a] = FieldValue(p + xyz[a]->offset, xyz[a]->datatype, cloud.big_endian);
+      }
+      if (!point.allFinite()) continue;
+      out->points.push_back(point);
+      if (intensity) {
+        out->intensity.push_back(static_cast<float>(
+            FieldValue(p + intensity->offset, intensity->datatype, cloud.big_endian)));
+      }
+      if (ring) {
+        out->ring.push_back(
+            static_cast<uint16_t>(FieldValue(p + ring->offset, ring->datatype, cloud.big_endian)));
+      }
+      if (time) {
+        const double value = FieldValue(p + time->offset, time->datatype, cloud.big_endian);
+        double t = integer_time ? 1e-9 * value : value;
+        // Absolute stamps (seconds since the epoch, e.g. Hesai's) become relative to the cloud's.
+        if (t > 1e8) t -= stamp_s;
+        out->time_s.push_back(t);
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace stcalib

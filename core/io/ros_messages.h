@@ -1,0 +1,67 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "core/types/status.h"
+
+namespace stcalib {
+
+// ROS 2 messages as a bag stores them: CDR (OMG XCDR version 1, little or big endian after a
+// 4-byte encapsulation header; primitives aligned to their size from the end of that header).
+// Only the messages and fields a calibration reads; every decoder checks every length against
+// the bytes it was given and names the message type in its errors.
+
+struct RosImage {
+  int64_t stamp_ns = 0;  ///< header.stamp [ns]
+  std::string frame_id;
+  uint32_t height = 0, width = 0, step = 0;
+  std::string encoding;  ///< e.g. "rgb8", "bgr8", "mono8", "mono16"
+  bool big_endian = false;
+  std::vector<uint8_t> data;
+};
+// sensor_msgs/msg/Image.
+Status DecodeImage(const std::vector<uint8_t>& cdr, RosImage* image);
+// The image as 8-bit BGR (rgb8, bgr8, mono8; mono16 scaled by 1/256); an error names any other
+// encoding.
+Status ImageToBgr(const RosImage& image, cv::Mat* bgr);
+
+struct RosPointField {
+  std::string name;
+  uint32_t offset = 0;
+  uint8_t datatype =
+      0;  ///< 1 int8, 2 uint8, 3 int16, 4 uint16, 5 int32, 6 uint32, 7 float32, 8 float64
+  uint32_t count = 1;
+};
+struct RosPointCloud {
+  int64_t stamp_ns = 0;
+  std::string frame_id;
+  uint32_t height = 0, width = 0, point_step = 0, row_step = 0;
+  std::vector<RosPointField> fields;
+  bool big_endian = false, dense = false;
+  std::vector<uint8_t> data;
+};
+// sensor_msgs/msg/PointCloud2.
+Status DecodePointCloud2(const std::vector<uint8_t>& cdr, RosPointCloud* cloud);
+
+// The points of a cloud, whatever its field layout: x, y, z (float32 or float64) and, when the
+// cloud has them, intensity, ring and a per-point time. The time field is the first of `time`,
+// `t`, `timestamp`; float fields are seconds, integer ones nanoseconds (Velodyne's driver writes
+// float seconds from the sweep's start, Ouster's uint32 ns, Hesai's float64 absolute seconds);
+// the times are returned relative to the cloud's stamp [s] (a time above 1e8 s is taken as
+// absolute, seconds since the epoch, and the stamp subtracted).
+struct CloudPoints {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<float> intensity;  ///< empty without an intensity field
+  std::vector<uint16_t> ring;    ///< empty without a ring field
+  std::vector<double> time_s;    ///< empty without a time field
+  std::string time_field;        ///< which field gave the times
+};
+// Points with a non-finite coordinate (a dense=false cloud's no-returns) are left out. Errors
+// name a missing x, y or z field, a field past the point's end and an inconsistent size.
+Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* points);
+
+}  // namespace stcalib

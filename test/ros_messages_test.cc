@@ -1,0 +1,192 @@
+// ROS 2 messages in CDR: bytes written here field by field from the OMG CDR rules (little and
+// big endian, primitives aligned to their size after the 4-byte encapsulation header) and the
+// sensor_msgs message definitions, decoded by core/io/ros_messages.h.
+
+#include "core/io/ros_messages.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace stcalib {
+namespace {
+
+using ::testing::HasSubstr;
+
+class CdrWriter {
+ public:
+  explicit CdrWriter(bool little = true) : little_(little) {
+    bytes_ = {0x00, static_cast<uint8_t>(little ? 0x01 : 0x00), 0x00, 0x00};
+  }
+  template <typename T>
+  CdrWriter& Put(T value) {
+    while ((bytes_.size() - 4) % sizeof(T) != 0) bytes_.push_back(0xee);  // padding
+    uint8_t raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));
+    for (size_t k = 0; k < sizeof(T); ++k) bytes_.push_back(raw[little_ ? k : sizeof(T) - 1 - k]);
+    return *this;
+  }
+  CdrWriter& String(const std::string& s) {
+    Put<uint32_t>(static_cast<uint32_t>(s.size() + 1));
+    bytes_.insert(bytes_.end(), s.begin(), s.end());
+    bytes_.push_back(0);
+    return *this;
+  }
+  CdrWriter& Bytes(const std::vector<uint8_t>& b) {
+    Put<uint32_t>(static_cast<uint32_t>(b.size()));
+    bytes_.insert(bytes_.end(), b.begin(), b.end());
+    return *this;
+  }
+  CdrWriter& Header(int32_t sec, uint32_t nanosec, const std::string& frame) {
+    return Put(sec).Put(nanosec).String(frame);
+  }
+  const std::vector<uint8_t>& bytes() const { return bytes_; }
+
+ private:
+  bool little_;
+  std::vector<uint8_t> bytes_;
+};
+
+TEST(RosMessages, DecodesImagesInEveryEncodingAndEndianness) {
+  // 2 × 2 rgb8 with a padded step of 8 bytes per row.
+  const std::vector<uint8_t> rgb = {10, 20, 30, 40, 50, 60, 0, 0, 70, 80, 90, 1, 2, 3, 0, 0};
+  for (bool little : {true, false}) {
+    CdrWriter w(little);
+    w.Header(1317046200, 123456789, "camera").Put<uint32_t>(2).Put<uint32_t>(2);
+    w.String("rgb8").Put<uint8_t>(0).Put<uint32_t>(8).Bytes(rgb);
+    RosImage image;
+    ASSERT_TRUE(DecodeImage(w.bytes(), &image).ok());
+    EXPECT_EQ(image.stamp_ns, 1317046200123456789);
+    EXPECT_EQ(image.frame_id, "camera");
+    EXPECT_EQ(image.encoding, "rgb8");
+    cv::Mat bgr;
+    ASSERT_TRUE(ImageToBgr(image, &bgr).ok());
+    ASSERT_EQ(bgr.type(), CV_8UC3);
+    EXPECT_EQ(bgr.at<cv::Vec3b>(0, 1), cv::Vec3b(60, 50, 40));
+    EXPECT_EQ(bgr.at<cv::Vec3b>(1, 0), cv::Vec3b(90, 80, 70));
+  }
+  // mono16, big endian pixels: 0x1234 -> 0x12 after the 1/256 scale.
+  CdrWriter w;
+  w.Header(5, 0, "ir").Put<uint32_t>(1).Put<uint32_t>(1).String("mono16");
+  w.Put<uint8_t>(1).Put<uint32_t>(2).Bytes({0x12, 0x34});
+  RosImage image;
+  ASSERT_TRUE(DecodeImage(w.bytes(), &image).ok());
+  cv::Mat bgr;
+  ASSERT_TRUE(ImageToBgr(image, &bgr).ok());
+  EXPECT_EQ(bgr.at<cv::Vec3b>(0, 0), cv::Vec3b(0x12, 0x12, 0x12));
+
+  image.encoding = "bayer_rggb8";
+  EXPECT_THAT(ImageToBgr(image, &bgr).message(), HasSubstr("\"bayer_rggb8\" is not supported"));
+  std::vector<uint8_t> cut = w.bytes();
+  cut.resize(cut.size() - 1);
+  EXPECT_THAT(DecodeImage(cut, &image).message(), HasSubstr("sensor_msgs/msg/Image: the CDR"));
+}
+
+struct Field {
+  std::string name;
+  uint32_t offset;
+  uint8_t datatype;
+};
+// A PointCloud2 of `points` rows of `point_step` bytes laid out by `fill`.
+std::vector<uint8_t> Cloud(const std::vector<Field>& fields, uint32_t point_step,
+                           const std::vector<std::vector<uint8_t>>& points, bool little = true) {
+  CdrWriter w(little);
+  w.Header(100, 500000000, "lidar").Put<uint32_t>(1).Put<uint32_t>(points.size());
+  w.Put<uint32_t>(fields.size());
+  for (const Field& f : fields) w.String(f.name).Put(f.offset).Put(f.datatype).Put<uint32_t>(1);
+  std::vector<uint8_t> data;
+  for (const auto& p : points) data.insert(data.end(), p.begin(), p.end());
+  w.Put<uint8_t>(little ? 0 : 1).Put(point_step).Put<uint32_t>(point_step * points.size());
+  w.Bytes(data).Put<uint8_t>(1);
+  return w.bytes();
+}
+template <typename T>
+void Place(std::vector<uint8_t>* point, uint32_t offset, T value, bool little = true) {
+  uint8_t raw[sizeof(T)];
+  std::memcpy(raw, &value, sizeof(T));
+  for (size_t k = 0; k < sizeof(T); ++k) (*point)[offset + k] = raw[little ? k : sizeof(T) - 1 - k];
+}
+
+// The three drivers' layouts: Velodyne (float32 x y z intensity, uint16 ring, float32 time in s
+// from the sweep's start), Ouster (float32 x y z intensity, uint32 t in ns, uint16 ring) and
+// Hesai (float32 x y z intensity, float64 absolute timestamp, uint16 ring).
+TEST(RosMessages, ReadsPointsOfEveryDriversLayout) {
+  {
+    const std::vector<Field> velodyne = {{"x", 0, 7},          {"y", 4, 7},     {"z", 8, 7},
+                                         {"intensity", 12, 7}, {"ring", 16, 4}, {"time", 18, 7}};
+    std::vector<uint8_t> p(22, 0), q(22, 0);
+    Place(&p, 0, 1.5f), Place(&p, 4, -2.0f), Place(&p, 8, 0.25f), Place(&p, 12, 40.0f);
+    Place<uint16_t>(&p, 16, 31), Place(&p, 18, 0.05f);
+    Place(&q, 0, std::nanf("")), Place(&q, 4, 1.0f), Place(&q, 8, 1.0f);  // a no-return
+    RosPointCloud cloud;
+    ASSERT_TRUE(DecodePointCloud2(Cloud(velodyne, 22, {p, q}), &cloud).ok());
+    EXPECT_EQ(cloud.stamp_ns, 100500000000);
+    CloudPoints points;
+    ASSERT_TRUE(ExtractCloudPoints(cloud, &points).ok());
+    ASSERT_EQ(points.points.size(), 1u);
+    EXPECT_EQ(points.points[0], Eigen::Vector3d(1.5, -2.0, 0.25));
+    EXPECT_EQ(points.intensity, std::vector<float>{40.0f});
+    EXPECT_EQ(points.ring, std::vector<uint16_t>{31});
+    EXPECT_EQ(points.time_field, "time");
+    EXPECT_NEAR(points.time_s[0], 0.05, 1e-7);
+  }
+  {
+    const std::vector<Field> ouster = {{"x", 0, 7},          {"y", 4, 7},  {"z", 8, 7},
+                                       {"intensity", 16, 7}, {"t", 20, 6}, {"ring", 26, 4}};
+    for (bool little : {true, false}) {
+      std::vector<uint8_t> p(48, 0);
+      Place(&p, 0, 3.0f, little), Place(&p, 4, 4.0f, little), Place(&p, 8, -1.0f, little);
+      Place<uint32_t>(&p, 20, 25000000, little), Place<uint16_t>(&p, 26, 63, little);
+      RosPointCloud cloud;
+      ASSERT_TRUE(DecodePointCloud2(Cloud(ouster, 48, {p}, little), &cloud).ok());
+      EXPECT_EQ(cloud.big_endian, !little);
+      CloudPoints points;
+      ASSERT_TRUE(ExtractCloudPoints(cloud, &points).ok());
+      ASSERT_EQ(points.points.size(), 1u);
+      EXPECT_EQ(points.points[0], Eigen::Vector3d(3, 4, -1));
+      EXPECT_EQ(points.time_field, "t");
+      EXPECT_NEAR(points.time_s[0], 0.025, 1e-12);  // integer ns
+      EXPECT_EQ(points.ring, std::vector<uint16_t>{63});
+    }
+  }
+  {
+    const std::vector<Field> hesai = {{"x", 0, 7},          {"y", 4, 7},          {"z", 8, 7},
+                                      {"intensity", 12, 7}, {"timestamp", 16, 8}, {"ring", 24, 4}};
+    std::vector<uint8_t> p(32, 0);
+    Place(&p, 0, 1.0f), Place(&p, 4, 1.0f), Place(&p, 8, 1.0f);
+    Place(&p, 16, 100.5 + 0.0125 + 1.7e9);  // absolute seconds
+    std::vector<uint8_t> bytes = Cloud(hesai, 32, {p});
+    RosPointCloud cloud;
+    ASSERT_TRUE(DecodePointCloud2(bytes, &cloud).ok());
+    cloud.stamp_ns += 1700000000000000000;  // the cloud stamped on the same epoch clock
+    CloudPoints points;
+    ASSERT_TRUE(ExtractCloudPoints(cloud, &points).ok());
+    EXPECT_NEAR(points.time_s[0], 0.0125, 1e-6);
+  }
+}
+
+TEST(RosMessages, BadCloudsAreNamed) {
+  std::vector<uint8_t> p(12, 0);
+  RosPointCloud cloud;
+  ASSERT_TRUE(DecodePointCloud2(Cloud({{"x", 0, 7}, {"y", 4, 7}}, 12, {p}), &cloud).ok());
+  CloudPoints points;
+  EXPECT_THAT(ExtractCloudPoints(cloud, &points).message(), HasSubstr("no field \"z\""));
+  ASSERT_TRUE(
+      DecodePointCloud2(Cloud({{"x", 0, 7}, {"y", 4, 7}, {"z", 10, 7}}, 12, {p}), &cloud).ok());
+  EXPECT_THAT(ExtractCloudPoints(cloud, &points).message(),
+              HasSubstr("field \"z\" (datatype 7 at offset 10) does not fit a point of 12 bytes"));
+  ASSERT_TRUE(
+      DecodePointCloud2(Cloud({{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}}, 12, {p}), &cloud).ok());
+  cloud.width = 2;  // claims two points, holds one
+  EXPECT_THAT(ExtractCloudPoints(cloud, &points).message(), HasSubstr("do not fit its 12 data"));
+  std::vector<uint8_t> cut = Cloud({{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}}, 12, {p});
+  cut.resize(cut.size() - 3);
+  EXPECT_THAT(DecodePointCloud2(cut, &cloud).message(),
+              HasSubstr("sensor_msgs/msg/PointCloud2: the CDR bytes end"));
+}
+
+}  // namespace
+}  // namespace stcalib
