@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/io/mcap.h"
+#include "core/io/ros_messages.h"
 #include "test/test_util.h"
 
 namespace stcalib {
@@ -261,6 +262,41 @@ TEST(Mcap, ReadsAFile) {
       },
       &read.summary);
   ExpectTheThreeMessages(read);
+}
+
+// The fuzzers' seed bag (written by a separate script from the specification): an Image outside
+// chunks and a PointCloud2 inside one, both decoded.
+TEST(Mcap, ReadsTheSeedBagAndDecodesItsMessages) {
+  const std::string path = std::string(STCALIB_FUZZ_REGRESSIONS_DIR) + "/mcap/image_and_cloud.mcap";
+  std::vector<RosImage> images;
+  std::vector<CloudPoints> clouds;
+  McapSummary summary;
+  const Status status = ReadMcap(
+      path,
+      [&](const McapChannel& channel, const McapMessage& message) {
+        if (channel.schema_name == "sensor_msgs/msg/Image") {
+          images.emplace_back();
+          EXPECT_TRUE(DecodeImage(message.data, &images.back()).ok());
+        } else if (channel.schema_name == "sensor_msgs/msg/PointCloud2") {
+          RosPointCloud cloud;
+          ASSERT_TRUE(DecodePointCloud2(message.data, &cloud).ok());
+          clouds.emplace_back();
+          EXPECT_TRUE(ExtractCloudPoints(cloud, &clouds.back()).ok());
+        }
+      },
+      &summary);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(summary.stopped, "");
+  ASSERT_EQ(images.size(), 1u);
+  EXPECT_EQ(images[0].width, 2u);
+  EXPECT_EQ(images[0].encoding, "rgb8");
+  EXPECT_EQ(images[0].data[11], 11);
+  ASSERT_EQ(clouds.size(), 1u);
+  ASSERT_EQ(clouds[0].points.size(), 2u);
+  EXPECT_EQ(clouds[0].points[1], Eigen::Vector3d(-1.0, 0.5, 9.0));
+  EXPECT_EQ(clouds[0].time_field, "t");
+  EXPECT_NEAR(clouds[0].time_s[1], 2e-6, 1e-15);
+  EXPECT_EQ(clouds[0].ring, (std::vector<uint16_t>{5, 6}));
 }
 
 }  // namespace

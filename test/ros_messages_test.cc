@@ -78,6 +78,9 @@ TEST(RosMessages, DecodesImagesInEveryEncodingAndEndianness) {
   ASSERT_TRUE(ImageToBgr(image, &bgr).ok());
   EXPECT_EQ(bgr.at<cv::Vec3b>(0, 0), cv::Vec3b(0x12, 0x12, 0x12));
 
+  RosImage empty = image;
+  empty.width = 0;
+  EXPECT_THAT(ImageToBgr(empty, &bgr).message(), HasSubstr("0 × 1 pixels is not an image size"));
   image.encoding = "bayer_rggb8";
   EXPECT_THAT(ImageToBgr(image, &bgr).message(), HasSubstr("\"bayer_rggb8\" is not supported"));
   std::vector<uint8_t> cut = w.bytes();
@@ -182,6 +185,12 @@ TEST(RosMessages, BadCloudsAreNamed) {
       DecodePointCloud2(Cloud({{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}}, 12, {p}), &cloud).ok());
   cloud.width = 2;  // claims two points, holds one
   EXPECT_THAT(ExtractCloudPoints(cloud, &points).message(), HasSubstr("do not fit its 12 data"));
+  std::vector<uint8_t> q(14, 0);
+  Place<int16_t>(&q, 12, -13);
+  ASSERT_TRUE(DecodePointCloud2(
+                  Cloud({{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}, {"ring", 12, 3}}, 14, {q}), &cloud)
+                  .ok());
+  EXPECT_THAT(ExtractCloudPoints(cloud, &points).message(), HasSubstr("\"ring\" holds -13"));
   std::vector<uint8_t> cut = Cloud({{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}}, 12, {p});
   cut.resize(cut.size() - 3);
   EXPECT_THAT(DecodePointCloud2(cut, &cloud).message(),

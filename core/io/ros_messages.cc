@@ -142,6 +142,11 @@ Status DecodeImage(const std::vector<uint8_t>& cdr, RosImage* image) {
 }
 
 Status ImageToBgr(const RosImage& image, cv::Mat* bgr) {
+  constexpr uint32_t kMaxSide = 1 << 16;
+  if (image.width == 0 || image.height == 0 || image.width > kMaxSide || image.height > kMaxSide) {
+    return Status::Error("sensor_msgs/msg/Image: " + std::to_string(image.width) + " × " +
+                         std::to_string(image.height) + " pixels is not an image size");
+  }
   const int rows = static_cast<int>(image.height), cols = static_cast<int>(image.width);
   auto view = [&](int type, int channel_bytes) -> Status {
     if (uint64_t{image.width} * channel_bytes > image.step) {
@@ -259,8 +264,12 @@ Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* out) {
             FieldValue(p + intensity->offset, intensity->datatype, cloud.big_endian)));
       }
       if (ring) {
-        out->ring.push_back(
-            static_cast<uint16_t>(FieldValue(p + ring->offset, ring->datatype, cloud.big_endian)));
+        const double value = FieldValue(p + ring->offset, ring->datatype, cloud.big_endian);
+        if (!(value >= 0 && value <= 65535)) {
+          return Status::Error(type + ": field \"ring\" holds " + std::to_string(value) +
+                               ", not a ring number");
+        }
+        out->ring.push_back(static_cast<uint16_t>(value));
       }
       if (time) {
         const double value = FieldValue(p + time->offset, time->datatype, cloud.big_endian);

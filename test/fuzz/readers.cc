@@ -6,7 +6,9 @@
 #include <vector>
 
 #include "core/io/kitti_calib.h"
+#include "core/io/mcap.h"
 #include "core/io/oxts.h"
+#include "core/io/ros_messages.h"
 #include "core/io/timestamps.h"
 #include "core/io/velodyne.h"
 
@@ -39,8 +41,44 @@ void CheckRigid(const std::string& reader, const std::string& path, const Rigid3
 
 }  // namespace
 
-const char* const kReaders[6] = {"velodyne",   "oxts",        "timestamps",
-                                 "cam_to_cam", "velo_to_cam", "imu_to_velo"};
+const char* const kReaders[8] = {"velodyne",    "oxts",        "timestamps", "cam_to_cam",
+                                 "velo_to_cam", "imu_to_velo", "mcap",       "ros_cdr"};
+
+namespace {
+
+// A CDR message decoded as an Image and as a PointCloud2: each decoder either names the message
+// type in its error or returns sizes that its data holds, and only finite points.
+void CheckCdr(const std::string& reader, const std::string& path, const std::vector<uint8_t>& cdr) {
+  RosImage image;
+  Status status = DecodeImage(cdr, &image);
+  if (!status.ok() && status.message().find("sensor_msgs/msg/Image") == std::string::npos) {
+    Broken(reader, path, "image error does not name the type: " + status.message());
+  }
+  if (status.ok() && uint64_t{image.step} * image.height > image.data.size()) {
+    Broken(reader, path, "image rows past its data accepted");
+  }
+  if (status.ok() && uint64_t{image.width} * image.height <= (1u << 22)) {
+    cv::Mat bgr;
+    if (ImageToBgr(image, &bgr).ok() &&
+        (bgr.rows != static_cast<int>(image.height) || bgr.cols != static_cast<int>(image.width))) {
+      Broken(reader, path, "converted image of another size");
+    }
+  }
+  RosPointCloud cloud;
+  status = DecodePointCloud2(cdr, &cloud);
+  if (!status.ok() && status.message().find("sensor_msgs/msg/PointCloud2") == std::string::npos) {
+    Broken(reader, path, "cloud error does not name the type: " + status.message());
+  }
+  CloudPoints points;
+  if (status.ok() && uint64_t{cloud.width} * cloud.height <= (1u << 22) &&
+      ExtractCloudPoints(cloud, &points).ok()) {
+    for (const Eigen::Vector3d& p : points.points) {
+      if (!p.allFinite()) Broken(reader, path, "non-finite cloud point accepted");
+    }
+  }
+}
+
+}  // namespace
 
 bool CheckReader(const std::string& name, const std::string& path) {
   if (name == "velodyne") {
@@ -81,6 +119,26 @@ bool CheckReader(const std::string& name, const std::string& path) {
     const Status status = name == "velo_to_cam" ? ReadVeloToCam(path, &T) : ReadImuToVelo(path, &T);
     CheckError(name, path, status);
     if (status.ok()) CheckRigid(name, path, T);
+  } else if (name == "mcap") {
+    McapSummary summary;
+    const Status status = ReadMcap(
+        path,
+        [&](const McapChannel& channel, const McapMessage& message) {
+          if (channel.id != message.channel_id) {
+            Broken(name, path, "a message delivered with another channel");
+          }
+          CheckCdr(name, path, message.data);
+        },
+        &summary);
+    CheckError(name, path, status);
+  } else if (name == "ros_cdr") {
+    std::FILE* file = std::fopen(path.c_str(), "rb");
+    if (file == nullptr) return true;
+    std::vector<uint8_t> bytes;
+    int c;
+    while ((c = std::fgetc(file)) != EOF) bytes.push_back(static_cast<uint8_t>(c));
+    std::fclose(file);
+    CheckCdr(name, path, bytes);
   } else {
     return false;
   }
