@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
@@ -86,6 +87,50 @@ TEST(RosMessages, DecodesImagesInEveryEncodingAndEndianness) {
   std::vector<uint8_t> cut = w.bytes();
   cut.resize(cut.size() - 1);
   EXPECT_THAT(DecodeImage(cut, &image).message(), HasSubstr("sensor_msgs/msg/Image: the CDR"));
+}
+
+TEST(RosMessages, DecodesCompressedImagesAndCameraInfo) {
+  cv::Mat picture(3, 4, CV_8UC3, cv::Scalar(10, 20, 30));
+  picture.at<cv::Vec3b>(1, 2) = cv::Vec3b(200, 100, 50);
+  std::vector<uint8_t> png;
+  ASSERT_TRUE(cv::imencode(".png", picture, png));
+  CdrWriter w;
+  w.Header(7, 8, "camera").String("png").Bytes(png);
+  int64_t stamp_ns = 0;
+  cv::Mat bgr;
+  ASSERT_TRUE(DecodeCompressedImage(w.bytes(), &stamp_ns, &bgr).ok());
+  EXPECT_EQ(stamp_ns, 7000000008);
+  ASSERT_EQ(bgr.size(), picture.size());
+  EXPECT_EQ(bgr.at<cv::Vec3b>(1, 2), cv::Vec3b(200, 100, 50));
+  CdrWriter junk;
+  junk.Header(7, 8, "camera").String("jpeg").Bytes({1, 2, 3});
+  EXPECT_THAT(DecodeCompressedImage(junk.bytes(), &stamp_ns, &bgr).message(),
+              HasSubstr("CompressedImage: its 3 bytes (format \"jpeg\") do not decode"));
+
+  // CameraInfo: the doubles after the distortion model's string are aligned to 8 bytes.
+  for (bool little : {true, false}) {
+    CdrWriter c(little);
+    c.Header(1, 2, "cam").Put<uint32_t>(375).Put<uint32_t>(1242).String("plumb_bob");
+    c.Put<uint32_t>(5);
+    for (double d : {-0.3, 0.1, 0.001, -0.002, 0.0}) c.Put(d);
+    for (double k : {721.5, 0.0, 609.6, 0.0, 721.5, 172.9, 0.0, 0.0, 1.0}) c.Put(k);
+    for (double r : {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}) c.Put(r);
+    for (int k = 0; k < 12; ++k) c.Put(k == 0 ? 721.5 : k == 3 ? 44.9 : 0.0);
+    c.Put<uint32_t>(0).Put<uint32_t>(0);
+    c.Put<uint32_t>(0).Put<uint32_t>(0).Put<uint32_t>(0).Put<uint32_t>(0).Put<uint8_t>(0);
+    RosCameraInfo info;
+    ASSERT_TRUE(DecodeCameraInfo(c.bytes(), &info).ok());
+    EXPECT_EQ(info.width, 1242u);
+    EXPECT_EQ(info.distortion_model, "plumb_bob");
+    EXPECT_EQ(info.d, (std::vector<double>{-0.3, 0.1, 0.001, -0.002, 0.0}));
+    EXPECT_EQ(info.K(0, 2), 609.6);
+    EXPECT_EQ(info.K(1, 2), 172.9);
+    EXPECT_EQ(info.R, Eigen::Matrix3d::Identity());
+    EXPECT_EQ(info.P(0, 3), 44.9);
+    std::vector<uint8_t> cut = c.bytes();
+    cut.resize(cut.size() - 2);
+    EXPECT_THAT(DecodeCameraInfo(cut, &info).message(), HasSubstr("CameraInfo: the CDR bytes"));
+  }
 }
 
 struct Field {

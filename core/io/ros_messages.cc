@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace stcalib {
@@ -180,6 +181,49 @@ Status ImageToBgr(const RosImage& image, cv::Mat* bgr) {
   if (image.encoding == "mono16") return view(CV_16UC1, 2);
   return Status::Error("sensor_msgs/msg/Image: encoding \"" + image.encoding +
                        "\" is not supported (rgb8, bgr8, mono8, mono16)");
+}
+
+Status DecodeCompressedImage(const std::vector<uint8_t>& cdr, int64_t* stamp_ns, cv::Mat* bgr) {
+  Cdr in(cdr);
+  std::string frame_id;
+  in.Header(stamp_ns, &frame_id);
+  const std::string format = in.String();
+  const std::vector<uint8_t> data = in.Bytes();
+  const std::string type = "sensor_msgs/msg/CompressedImage";
+  if (!in.ok()) return Truncated(type);
+  cv::Mat decoded;
+  try {
+    decoded = data.empty() ? cv::Mat() : cv::imdecode(data, cv::IMREAD_COLOR);
+  } catch (const cv::Exception& e) {
+    decoded = cv::Mat();
+  }
+  if (decoded.empty()) {
+    return Status::Error(type + ": its " + std::to_string(data.size()) + " bytes (format \"" +
+                         format + "\") do not decode as an image");
+  }
+  *bgr = decoded;
+  return Status::Ok();
+}
+
+Status DecodeCameraInfo(const std::vector<uint8_t>& cdr, RosCameraInfo* info) {
+  Cdr in(cdr);
+  *info = RosCameraInfo();
+  in.Header(&info->stamp_ns, &info->frame_id);
+  info->height = in.Get<uint32_t>();
+  info->width = in.Get<uint32_t>();
+  info->distortion_model = in.String();
+  const uint32_t n = in.Get<uint32_t>();
+  if (n > cdr.size() / 8) return Truncated("sensor_msgs/msg/CameraInfo");
+  for (uint32_t k = 0; k < n; ++k) info->d.push_back(in.Get<double>());
+  for (int k = 0; k < 9; ++k) info->K(k / 3, k % 3) = in.Get<double>();
+  for (int k = 0; k < 9; ++k) info->R(k / 3, k % 3) = in.Get<double>();
+  for (int k = 0; k < 12; ++k) info->P(k / 4, k % 4) = in.Get<double>();
+  in.Get<uint32_t>();                              // binning_x
+  in.Get<uint32_t>();                              // binning_y
+  for (int k = 0; k < 4; ++k) in.Get<uint32_t>();  // roi: x_offset, y_offset, height, width
+  in.Get<uint8_t>();                               // roi.do_rectify
+  if (!in.ok()) return Truncated("sensor_msgs/msg/CameraInfo");
+  return Status::Ok();
 }
 
 Status DecodePointCloud2(const std::vector<uint8_t>& cdr, RosPointCloud* cloud) {

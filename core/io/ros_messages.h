@@ -29,6 +29,23 @@ Status DecodeImage(const std::vector<uint8_t>& cdr, RosImage* image);
 // encoding.
 Status ImageToBgr(const RosImage& image, cv::Mat* bgr);
 
+// sensor_msgs/msg/CompressedImage (format "jpeg", "png", or ROS's "bgr8; jpeg compressed bgr8"),
+// decoded to 8-bit BGR; an error names an image that does not decode.
+Status DecodeCompressedImage(const std::vector<uint8_t>& cdr, int64_t* stamp_ns, cv::Mat* bgr);
+
+struct RosCameraInfo {
+  int64_t stamp_ns = 0;
+  std::string frame_id;
+  uint32_t height = 0, width = 0;
+  std::string distortion_model;  ///< "plumb_bob", "rational_polynomial", "equidistant", ...
+  std::vector<double> d;         ///< distortion coefficients
+  Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d R = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<double, 3, 4> P = Eigen::Matrix<double, 3, 4>::Zero();
+};
+// sensor_msgs/msg/CameraInfo (binning and region of interest are read past, not kept).
+Status DecodeCameraInfo(const std::vector<uint8_t>& cdr, RosCameraInfo* info);
+
 struct RosPointField {
   std::string name;
   uint32_t offset = 0;

@@ -46,8 +46,8 @@ const char* const kReaders[8] = {"velodyne",    "oxts",        "timestamps", "ca
 
 namespace {
 
-// A CDR message decoded as an Image and as a PointCloud2: each decoder either names the message
-// type in its error or returns sizes that its data holds, and only finite points.
+// A CDR message decoded as each message type: each decoder either names the message type in its
+// error or returns sizes that its data holds, and only finite points.
 void CheckCdr(const std::string& reader, const std::string& path, const std::vector<uint8_t>& cdr) {
   RosImage image;
   Status status = DecodeImage(cdr, &image);
@@ -63,6 +63,18 @@ void CheckCdr(const std::string& reader, const std::string& path, const std::vec
         (bgr.rows != static_cast<int>(image.height) || bgr.cols != static_cast<int>(image.width))) {
       Broken(reader, path, "converted image of another size");
     }
+  }
+  int64_t stamp_ns = 0;
+  cv::Mat decoded;
+  status = DecodeCompressedImage(cdr, &stamp_ns, &decoded);
+  if (!status.ok() &&
+      status.message().find("sensor_msgs/msg/CompressedImage") == std::string::npos) {
+    Broken(reader, path, "compressed image error does not name the type: " + status.message());
+  }
+  RosCameraInfo info;
+  status = DecodeCameraInfo(cdr, &info);
+  if (!status.ok() && status.message().find("sensor_msgs/msg/CameraInfo") == std::string::npos) {
+    Broken(reader, path, "camera info error does not name the type: " + status.message());
   }
   RosPointCloud cloud;
   status = DecodePointCloud2(cdr, &cloud);
