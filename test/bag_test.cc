@@ -4,15 +4,18 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <lz4frame.h>
+#include <sqlite3.h>
 #include <zstd.h>
 
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include "core/io/mcap.h"
 #include "core/io/ros_messages.h"
+#include "core/io/rosbag2.h"
 #include "test/test_util.h"
 
 namespace stcalib {
@@ -297,6 +300,99 @@ TEST(Mcap, ReadsTheSeedBagAndDecodesItsMessages) {
   EXPECT_EQ(clouds[0].time_field, "t");
   EXPECT_NEAR(clouds[0].time_s[1], 2e-6, 1e-15);
   EXPECT_EQ(clouds[0].ring, (std::vector<uint16_t>{5, 6}));
+}
+
+// A rosbag2 SQLite file as rosbag2's default storage plugin lays it out.
+void WriteDb3(const std::string& path) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  const char* sql =
+      "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, "
+      "serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL);"
+      "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, "
+      "timestamp INTEGER NOT NULL, data BLOB NOT NULL);"
+      "INSERT INTO topics VALUES(1, '/camera/image_raw', 'sensor_msgs/msg/Image', 'cdr', '');"
+      "INSERT INTO topics VALUES(2, '/lidar/points', 'sensor_msgs/msg/PointCloud2', 'cdr', '');"
+      "INSERT INTO topics VALUES(3, '/imu', 'sensor_msgs/msg/Imu', 'cdr', '');"
+      "INSERT INTO messages VALUES(1, 2, 2000, x'0405');"
+      "INSERT INTO messages VALUES(2, 1, 1000, x'010203');"
+      "INSERT INTO messages VALUES(3, 1, 3000, x'');";
+  ASSERT_EQ(sqlite3_exec(db, sql, nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+  sqlite3_close(db);
+}
+
+struct BagRead {
+  Status status = Status::Ok();
+  BagSummary summary;
+  std::vector<std::string> topics;
+  std::vector<int64_t> times;
+  std::vector<Bytes> data;
+};
+BagRead ReadBag(const std::string& folder) {
+  BagRead read;
+  read.status = ReadRosbag2(
+      folder,
+      [&](const BagMessage& message) {
+        read.topics.push_back(message.topic->name + " " + message.topic->type);
+        read.times.push_back(message.log_time_ns);
+        read.data.push_back(message.data);
+      },
+      &read.summary);
+  return read;
+}
+
+TEST(Rosbag2, ReadsSqliteAndMcapFolders) {
+  testing::ScopedTempDir tmp;
+  const std::string sqlite_bag = tmp.path() + "/sqlite_bag";
+  std::filesystem::create_directories(sqlite_bag);
+  WriteDb3(sqlite_bag + "/sqlite_bag_0.db3");
+  std::ofstream(sqlite_bag + "/metadata.yaml")
+      << "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n"
+         "  relative_file_paths:\n    - sqlite_bag_0.db3\n  duration:\n    nanoseconds: 2000\n";
+  const BagRead db3 = ReadBag(sqlite_bag);
+  ASSERT_TRUE(db3.status.ok()) << db3.status.message();
+  EXPECT_EQ(db3.summary.files, std::vector<std::string>{sqlite_bag + "/sqlite_bag_0.db3"});
+  EXPECT_EQ(db3.times, (std::vector<int64_t>{1000, 2000, 3000}));  // by timestamp
+  EXPECT_EQ(db3.topics[1], "/lidar/points sensor_msgs/msg/PointCloud2");
+  EXPECT_EQ(db3.data[0], (Bytes{1, 2, 3}));
+  EXPECT_EQ(db3.summary.topics.size(), 3u);
+  EXPECT_EQ(db3.summary.message_count.at("/camera/image_raw"), 2u);
+  EXPECT_THAT(ListBagTopics(db3.summary), HasSubstr("  /imu  [sensor_msgs/msg/Imu], 0 messages"));
+
+  const std::string mcap_bag = tmp.path() + "/mcap_bag";  // no metadata.yaml: found by name
+  std::filesystem::create_directories(mcap_bag);
+  Bytes data;
+  PutRecord(&data, 0x06, Chunk(Records(), "zstd"));
+  const Bytes file = File(data);
+  std::ofstream(mcap_bag + "/mcap_bag_0.mcap", std::ios::binary)
+      .write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+  const BagRead mcap = ReadBag(mcap_bag);
+  ASSERT_TRUE(mcap.status.ok()) << mcap.status.message();
+  EXPECT_EQ(mcap.times, (std::vector<int64_t>{5000, 6000, 7000}));
+  EXPECT_EQ(mcap.topics[0], "/camera/image_raw sensor_msgs/msg/Image");
+  EXPECT_EQ(mcap.summary.message_count.at("/lidar/points"), 1u);
+}
+
+TEST(Rosbag2, BadBagsAreNamed) {
+  testing::ScopedTempDir tmp;
+  EXPECT_THAT(ReadBag(tmp.path() + "/none").status.message(), HasSubstr("/none: not a folder"));
+  EXPECT_THAT(ReadBag(tmp.path()).status.message(), HasSubstr(": no storage file"));
+  const std::string listed = tmp.path() + "/listed";
+  std::filesystem::create_directories(listed);
+  std::ofstream(listed + "/metadata.yaml") << "  relative_file_paths:\n    - gone_0.mcap\n";
+  EXPECT_THAT(ReadBag(listed).status.message(),
+              HasSubstr("gone_0.mcap: listed in metadata.yaml but missing"));
+  const std::string not_sqlite = tmp.path() + "/not_sqlite";
+  std::filesystem::create_directories(not_sqlite);
+  std::ofstream(not_sqlite + "/x_0.db3") << "this is not a database, just text";
+  EXPECT_THAT(ReadBag(not_sqlite).status.message(), HasSubstr("x_0.db3: "));
+  const std::string no_tables = tmp.path() + "/no_tables";
+  std::filesystem::create_directories(no_tables);
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((no_tables + "/y_0.db3").c_str(), &db), SQLITE_OK);
+  sqlite3_exec(db, "CREATE TABLE other(a INTEGER);", nullptr, nullptr, nullptr);
+  sqlite3_close(db);
+  EXPECT_THAT(ReadBag(no_tables).status.message(), HasSubstr("no table `topics`"));
 }
 
 }  // namespace
