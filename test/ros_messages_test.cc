@@ -133,6 +133,42 @@ TEST(RosMessages, DecodesCompressedImagesAndCameraInfo) {
   }
 }
 
+TEST(RosMessages, DecodesImuAndOdometry) {
+  for (bool little : {true, false}) {
+    CdrWriter imu(little);
+    imu.Header(3, 4, "imu_link");
+    for (double q : {0.0, 0.0, 0.7071067811865476, 0.7071067811865476}) imu.Put(q);  // x y z w
+    for (int k = 0; k < 9; ++k) imu.Put(0.01);
+    imu.Put(0.1).Put(-0.2).Put(0.3);
+    for (int k = 0; k < 9; ++k) imu.Put(0.01);
+    imu.Put(0.5).Put(0.0).Put(9.81);
+    for (int k = 0; k < 9; ++k) imu.Put(0.01);
+    RosImu decoded;
+    ASSERT_TRUE(DecodeImu(imu.bytes(), &decoded).ok());
+    EXPECT_EQ(decoded.stamp_ns, 3000000004);
+    EXPECT_NEAR(decoded.orientation.toRotationMatrix()(1, 0), 1.0, 1e-12);  // 90° about z
+    EXPECT_EQ(decoded.angular_velocity_rad_s, Eigen::Vector3d(0.1, -0.2, 0.3));
+    EXPECT_EQ(decoded.linear_acceleration_m_s2, Eigen::Vector3d(0.5, 0.0, 9.81));
+    std::vector<uint8_t> cut = imu.bytes();
+    cut.resize(cut.size() - 8);
+    EXPECT_THAT(DecodeImu(cut, &decoded).message(), HasSubstr("sensor_msgs/msg/Imu: the CDR"));
+
+    CdrWriter odometry(little);
+    odometry.Header(5, 6, "odom").String("base_link");
+    odometry.Put(1.0).Put(2.0).Put(3.0);
+    for (double q : {0.0, 0.0, 0.0, 1.0}) odometry.Put(q);
+    for (int k = 0; k < 36; ++k) odometry.Put(0.0);
+    odometry.Put(8.0).Put(0.1).Put(0.0).Put(0.0).Put(0.0).Put(0.05);
+    for (int k = 0; k < 36; ++k) odometry.Put(0.0);
+    RosOdometry o;
+    ASSERT_TRUE(DecodeOdometry(odometry.bytes(), &o).ok());
+    EXPECT_EQ(o.child_frame_id, "base_link");
+    EXPECT_EQ(o.position_m, Eigen::Vector3d(1, 2, 3));
+    EXPECT_EQ(o.linear_m_s, Eigen::Vector3d(8.0, 0.1, 0.0));
+    EXPECT_EQ(o.angular_rad_s, Eigen::Vector3d(0, 0, 0.05));
+  }
+}
+
 struct Field {
   std::string name;
   uint32_t offset;

@@ -226,6 +226,53 @@ Status DecodeCameraInfo(const std::vector<uint8_t>& cdr, RosCameraInfo* info) {
   return Status::Ok();
 }
 
+namespace {
+
+Eigen::Vector3d GetVector3(Cdr* in) {
+  const double x = in->Get<double>(), y = in->Get<double>(), z = in->Get<double>();
+  return Eigen::Vector3d(x, y, z);
+}
+// geometry_msgs/msg/Quaternion: x, y, z, w.
+Eigen::Quaterniond GetQuaternion(Cdr* in) {
+  const double x = in->Get<double>(), y = in->Get<double>(), z = in->Get<double>();
+  const double w = in->Get<double>();
+  return Eigen::Quaterniond(w, x, y, z);
+}
+void SkipDoubles(Cdr* in, int n) {
+  for (int k = 0; k < n; ++k) in->Get<double>();
+}
+
+}  // namespace
+
+Status DecodeImu(const std::vector<uint8_t>& cdr, RosImu* imu) {
+  Cdr in(cdr);
+  *imu = RosImu();
+  in.Header(&imu->stamp_ns, &imu->frame_id);
+  imu->orientation = GetQuaternion(&in);
+  SkipDoubles(&in, 9);
+  imu->angular_velocity_rad_s = GetVector3(&in);
+  SkipDoubles(&in, 9);
+  imu->linear_acceleration_m_s2 = GetVector3(&in);
+  SkipDoubles(&in, 9);
+  if (!in.ok()) return Truncated("sensor_msgs/msg/Imu");
+  return Status::Ok();
+}
+
+Status DecodeOdometry(const std::vector<uint8_t>& cdr, RosOdometry* odometry) {
+  Cdr in(cdr);
+  *odometry = RosOdometry();
+  in.Header(&odometry->stamp_ns, &odometry->frame_id);
+  odometry->child_frame_id = in.String();
+  odometry->position_m = GetVector3(&in);
+  odometry->orientation = GetQuaternion(&in);
+  SkipDoubles(&in, 36);
+  odometry->linear_m_s = GetVector3(&in);
+  odometry->angular_rad_s = GetVector3(&in);
+  SkipDoubles(&in, 36);
+  if (!in.ok()) return Truncated("nav_msgs/msg/Odometry");
+  return Status::Ok();
+}
+
 Status DecodePointCloud2(const std::vector<uint8_t>& cdr, RosPointCloud* cloud) {
   Cdr in(cdr);
   *cloud = RosPointCloud();

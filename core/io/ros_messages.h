@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <string>
@@ -45,6 +46,27 @@ struct RosCameraInfo {
 };
 // sensor_msgs/msg/CameraInfo (binning and region of interest are read past, not kept).
 Status DecodeCameraInfo(const std::vector<uint8_t>& cdr, RosCameraInfo* info);
+
+struct RosImu {
+  int64_t stamp_ns = 0;
+  std::string frame_id;
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d linear_acceleration_m_s2 = Eigen::Vector3d::Zero();
+};
+// sensor_msgs/msg/Imu (the covariances are read past).
+Status DecodeImu(const std::vector<uint8_t>& cdr, RosImu* imu);
+
+struct RosOdometry {
+  int64_t stamp_ns = 0;
+  std::string frame_id, child_frame_id;
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d linear_m_s = Eigen::Vector3d::Zero();     ///< in child_frame_id
+  Eigen::Vector3d angular_rad_s = Eigen::Vector3d::Zero();  ///< in child_frame_id
+};
+// nav_msgs/msg/Odometry (the covariances are read past).
+Status DecodeOdometry(const std::vector<uint8_t>& cdr, RosOdometry* odometry);
 
 struct RosPointField {
   std::string name;

@@ -76,6 +76,16 @@ void CheckCdr(const std::string& reader, const std::string& path, const std::vec
   if (!status.ok() && status.message().find("sensor_msgs/msg/CameraInfo") == std::string::npos) {
     Broken(reader, path, "camera info error does not name the type: " + status.message());
   }
+  RosImu imu;
+  status = DecodeImu(cdr, &imu);
+  if (!status.ok() && status.message().find("sensor_msgs/msg/Imu") == std::string::npos) {
+    Broken(reader, path, "imu error does not name the type: " + status.message());
+  }
+  RosOdometry odometry;
+  status = DecodeOdometry(cdr, &odometry);
+  if (!status.ok() && status.message().find("nav_msgs/msg/Odometry") == std::string::npos) {
+    Broken(reader, path, "odometry error does not name the type: " + status.message());
+  }
   RosPointCloud cloud;
   status = DecodePointCloud2(cdr, &cloud);
   if (!status.ok() && status.message().find("sensor_msgs/msg/PointCloud2") == std::string::npos) {

@@ -6,7 +6,7 @@ namespace stcalib::fuzz {
 
 // The readers under fuzzing, by name: velodyne (velodyne .bin and labels .bin), oxts (one
 // packet), timestamps, cam_to_cam, velo_to_cam, imu_to_velo, mcap (a ROS 2 bag's file, each
-// message decoded as below), ros_cdr (one CDR message as an Image, a CompressedImage, a CameraInfo and a PointCloud2).
+// message decoded as below), ros_cdr (one CDR message as each message type the bag path decodes).
 extern const char* const kReaders[8];
 
 // Runs reader `name` on the file at `path` and checks what it promises: either an error that
