@@ -504,6 +504,38 @@ void OnlineCalibrator::MeasureEstimate(WindowScorer* scorer, WindowScorer* healt
   last_health_ = report->health;
 }
 
+RotationGridResult OnlineCalibrator::AcquisitionGrid(
+    WindowScorer* long_scorer, const CalibrationState& centre,
+    const AdaptiveGridSearchOptions& search_options, bool wide) {
+  if (!wide || !(options_.wide_time_offset_s > 0)) {
+    return RotationGridSearch(long_scorer, centre, anchor_, search_options,
+                              wide ? options_.wide_grid_deg : options_.lost_grid_deg,
+                              options_.lost_grid_step_deg, -1, &grid_cache_);
+  }
+  // A δ0 far off moves the near points' bearings by degrees (8 m/s × 0.1 s is 0.8 m): the wide
+  // grid runs at the estimate's δ and at five δ across the start's uncertainty around δ0, and the
+  // best (rotation, δ) wins. Its per-frame scores are not kept (the translation moves between
+  // frames): measured, docs/results.md#wide-start.
+  std::vector<double> offsets = {centre.time_offset_s};
+  for (int k = -2; k <= 2; ++k) {
+    offsets.push_back(std::clamp(anchor_.time_offset_s + k * options_.wide_time_offset_s / 2,
+                                 -options_.time_offset_bound_s, options_.time_offset_bound_s));
+  }
+  RotationGridResult best;
+  int evaluations = 0;
+  for (size_t k = 0; k < offsets.size(); ++k) {
+    CalibrationState at_offset = centre;
+    at_offset.time_offset_s = offsets[k];
+    const RotationGridResult grid =
+        RotationGridSearch(long_scorer, at_offset, anchor_, search_options, options_.wide_grid_deg,
+                           options_.lost_grid_step_deg, -1, nullptr);
+    evaluations += grid.evaluations;
+    if (k == 0 || grid.score > best.score) best = grid;
+  }
+  best.evaluations = evaluations;
+  return best;
+}
+
 void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
                               AdaptiveGridSearchOptions* search_options, FrameReport* report) {
   const auto start = std::chrono::steady_clock::now();
@@ -520,32 +552,8 @@ void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
     CalibrationState centre = state_;
     centre.T_camera_lidar.linear() = grid_center_rotation_;
     const bool wide = !grid_narrowed_;
-    RotationGridResult grid;
-    if (wide && options_.wide_time_offset_s > 0) {
-      // A δ0 far off moves the near points' bearings by degrees (8 m/s × 0.1 s is 0.8 m): the
-      // wide grid runs at the estimate's δ and at five δ across the start's uncertainty around
-      // δ0, and the best (rotation, δ) wins. Its per-frame scores are not kept (the translation
-      // moves between frames): measured, docs/results.md#wide-start.
-      std::vector<double> offsets = {state_.time_offset_s};
-      for (int k = -2; k <= 2; ++k) {
-        offsets.push_back(std::clamp(anchor_.time_offset_s + k * options_.wide_time_offset_s / 2,
-                                     -options_.time_offset_bound_s, options_.time_offset_bound_s));
-      }
-      for (size_t k = 0; k < offsets.size(); ++k) {
-        CalibrationState at_offset = centre;
-        at_offset.time_offset_s = offsets[k];
-        const RotationGridResult g =
-            RotationGridSearch(long_scorer, at_offset, anchor_, *search_options,
-                               options_.wide_grid_deg, options_.lost_grid_step_deg, -1, nullptr);
-        grid_evaluations += g.evaluations;
-        if (k == 0 || g.score > grid.score) grid = g;
-      }
-    } else {
-      grid = RotationGridSearch(long_scorer, centre, anchor_, *search_options,
-                                wide ? options_.wide_grid_deg : options_.lost_grid_deg,
-                                options_.lost_grid_step_deg, -1, &grid_cache_);
-      grid_evaluations = grid.evaluations;
-    }
+    const RotationGridResult grid = AcquisitionGrid(long_scorer, centre, *search_options, wide);
+    grid_evaluations = grid.evaluations;
     // Agreement: the estimate is within one lattice step (diagonals included) of the grid's
     // best point, i.e. on the same peak.
     const double grid_offset_deg =

@@ -351,6 +351,10 @@ class OnlineCalibrator {
   // to report->after (by a full step when `full_step`).
   void Update(WindowScorer* scorer, bool full_step, FrameReport* report);
   std::vector<const CalibrationFrame*> RefineWindow() const;  ///< latest refine_frames
+  // The rotation grid around `centre` (its translation and δ): ±lost_grid_deg, or while `wide`
+  // ±wide_grid_deg, at several δ when wide_time_offset_s is set (the best pair).
+  RotationGridResult AcquisitionGrid(WindowScorer* long_scorer, const CalibrationState& centre,
+                                     const AdaptiveGridSearchOptions& search_options, bool wide);
   // Rotation grid (when lost or acquiring; ends acquisition when it agrees with the estimate on
   // a full window) then the adaptive search: fills report->search and search_ms.
   void Search(WindowScorer* scorer, WindowScorer* long_scorer,
