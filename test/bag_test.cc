@@ -120,16 +120,28 @@ Bytes File(const Bytes& data_records) {
   file.insert(file.end(), kMagic.begin(), kMagic.end());
   return file;
 }
-// Schemas and channels for an image and a cloud topic, then three messages.
-Bytes Records() {
+// Schemas and channels for an image and a cloud topic.
+Bytes SchemasAndChannels() {
   Bytes r;
   PutRecord(&r, 0x03, Schema(1, "sensor_msgs/msg/Image"));
   PutRecord(&r, 0x03, Schema(2, "sensor_msgs/msg/PointCloud2"));
   PutRecord(&r, 0x04, Channel(1, 1, "/camera/image_raw"));
   PutRecord(&r, 0x04, Channel(2, 2, "/lidar/points"));
-  PutRecord(&r, 0x05, Message(1, 7, 5000, {1, 2, 3}));
-  PutRecord(&r, 0x05, Message(2, 8, 6000, {4, 5}));
-  PutRecord(&r, 0x05, Message(1, 9, 7000, {}));
+  return r;
+}
+// Message records [first, last) of the three: image, cloud, image.
+Bytes Messages(int first, int last) {
+  const Bytes all[3] = {Message(1, 7, 5000, {1, 2, 3}), Message(2, 8, 6000, {4, 5}),
+                        Message(1, 9, 7000, {})};
+  Bytes r;
+  for (int k = first; k < last; ++k) PutRecord(&r, 0x05, all[k]);
+  return r;
+}
+// The schemas and channels, then the three messages.
+Bytes Records() {
+  Bytes r = SchemasAndChannels();
+  const Bytes messages = Messages(0, 3);
+  r.insert(r.end(), messages.begin(), messages.end());
   return r;
 }
 
@@ -182,14 +194,10 @@ TEST(Mcap, ReadsUncompressedZstdAndLz4Chunks) {
     ExpectTheThreeMessages(Parse(File(data)));
   }
   // Two chunks, the channels in the first, the messages split across both.
-  Bytes first, second;
-  PutRecord(&first, 0x03, Schema(1, "sensor_msgs/msg/Image"));
-  PutRecord(&first, 0x03, Schema(2, "sensor_msgs/msg/PointCloud2"));
-  PutRecord(&first, 0x04, Channel(1, 1, "/camera/image_raw"));
-  PutRecord(&first, 0x04, Channel(2, 2, "/lidar/points"));
-  PutRecord(&first, 0x05, Message(1, 7, 5000, {1, 2, 3}));
-  PutRecord(&second, 0x05, Message(2, 8, 6000, {4, 5}));
-  PutRecord(&second, 0x05, Message(1, 9, 7000, {}));
+  Bytes first = SchemasAndChannels();
+  const Bytes first_message = Messages(0, 1);
+  first.insert(first.end(), first_message.begin(), first_message.end());
+  const Bytes second = Messages(1, 3);
   Bytes data;
   PutRecord(&data, 0x06, Chunk(first, "zstd"));
   PutRecord(&data, 0x06, Chunk(second, "lz4"));

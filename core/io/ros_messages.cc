@@ -18,6 +18,7 @@ class Cdr {
     at_ = 4;
   }
   bool ok() const { return ok_; }
+  void Fail() { ok_ = false; }  ///< a length the bytes cannot hold
   template <typename T>
   T Get() {
     T value{};
@@ -73,6 +74,17 @@ Status Truncated(const std::string& type) {
   return Status::Error(type + ": the CDR bytes end before the message does (or bad encapsulation)");
 }
 
+// A message of `type`, reset and then filled by `read` field by field from the CDR bytes; the
+// first read past the end (or a bad encapsulation header) makes it an error naming the type.
+template <typename Message, typename Read>
+Status Decode(const std::vector<uint8_t>& cdr, const std::string& type, Message* message,
+              Read read) {
+  Cdr in(cdr);
+  *message = Message();
+  read(&in, message);
+  return in.ok() ? Status::Ok() : Truncated(type);
+}
+
 size_t DatatypeBytes(uint8_t datatype) {
   switch (datatype) {
     case 1:
@@ -124,16 +136,15 @@ double FieldValue(const uint8_t* p, uint8_t datatype, bool big_endian) {
 }  // namespace
 
 Status DecodeImage(const std::vector<uint8_t>& cdr, RosImage* image) {
-  Cdr in(cdr);
-  *image = RosImage();
-  in.Header(&image->stamp_ns, &image->frame_id);
-  image->height = in.Get<uint32_t>();
-  image->width = in.Get<uint32_t>();
-  image->encoding = in.String();
-  image->big_endian = in.Get<uint8_t>() != 0;
-  image->step = in.Get<uint32_t>();
-  image->data = in.Bytes();
-  if (!in.ok()) return Truncated("sensor_msgs/msg/Image");
+  STCALIB_RETURN_IF_ERROR(Decode(cdr, "sensor_msgs/msg/Image", image, [](Cdr* in, RosImage* m) {
+    in->Header(&m->stamp_ns, &m->frame_id);
+    m->height = in->Get<uint32_t>();
+    m->width = in->Get<uint32_t>();
+    m->encoding = in->String();
+    m->big_endian = in->Get<uint8_t>() != 0;
+    m->step = in->Get<uint32_t>();
+    m->data = in->Bytes();
+  }));
   if (uint64_t{image->step} * image->height > image->data.size()) {
     return Status::Error("sensor_msgs/msg/Image: " + std::to_string(image->height) + " rows of " +
                          std::to_string(image->step) + " bytes need more than its " +
@@ -206,24 +217,22 @@ Status DecodeCompressedImage(const std::vector<uint8_t>& cdr, int64_t* stamp_ns,
 }
 
 Status DecodeCameraInfo(const std::vector<uint8_t>& cdr, RosCameraInfo* info) {
-  Cdr in(cdr);
-  *info = RosCameraInfo();
-  in.Header(&info->stamp_ns, &info->frame_id);
-  info->height = in.Get<uint32_t>();
-  info->width = in.Get<uint32_t>();
-  info->distortion_model = in.String();
-  const uint32_t n = in.Get<uint32_t>();
-  if (n > cdr.size() / 8) return Truncated("sensor_msgs/msg/CameraInfo");
-  for (uint32_t k = 0; k < n; ++k) info->d.push_back(in.Get<double>());
-  for (int k = 0; k < 9; ++k) info->K(k / 3, k % 3) = in.Get<double>();
-  for (int k = 0; k < 9; ++k) info->R(k / 3, k % 3) = in.Get<double>();
-  for (int k = 0; k < 12; ++k) info->P(k / 4, k % 4) = in.Get<double>();
-  in.Get<uint32_t>();                              // binning_x
-  in.Get<uint32_t>();                              // binning_y
-  for (int k = 0; k < 4; ++k) in.Get<uint32_t>();  // roi: x_offset, y_offset, height, width
-  in.Get<uint8_t>();                               // roi.do_rectify
-  if (!in.ok()) return Truncated("sensor_msgs/msg/CameraInfo");
-  return Status::Ok();
+  return Decode(cdr, "sensor_msgs/msg/CameraInfo", info, [&](Cdr* in, RosCameraInfo* m) {
+    in->Header(&m->stamp_ns, &m->frame_id);
+    m->height = in->Get<uint32_t>();
+    m->width = in->Get<uint32_t>();
+    m->distortion_model = in->String();
+    const uint32_t n = in->Get<uint32_t>();
+    if (n > cdr.size() / 8) return in->Fail();
+    for (uint32_t k = 0; k < n; ++k) m->d.push_back(in->Get<double>());
+    for (int k = 0; k < 9; ++k) m->K(k / 3, k % 3) = in->Get<double>();
+    for (int k = 0; k < 9; ++k) m->R(k / 3, k % 3) = in->Get<double>();
+    for (int k = 0; k < 12; ++k) m->P(k / 4, k % 4) = in->Get<double>();
+    in->Get<uint32_t>();                              // binning_x
+    in->Get<uint32_t>();                              // binning_y
+    for (int k = 0; k < 4; ++k) in->Get<uint32_t>();  // roi: x_offset, y_offset, height, width
+    in->Get<uint8_t>();                               // roi.do_rectify
+  });
 }
 
 namespace {
@@ -245,56 +254,50 @@ void SkipDoubles(Cdr* in, int n) {
 }  // namespace
 
 Status DecodeImu(const std::vector<uint8_t>& cdr, RosImu* imu) {
-  Cdr in(cdr);
-  *imu = RosImu();
-  in.Header(&imu->stamp_ns, &imu->frame_id);
-  imu->orientation = GetQuaternion(&in);
-  SkipDoubles(&in, 9);
-  imu->angular_velocity_rad_s = GetVector3(&in);
-  SkipDoubles(&in, 9);
-  imu->linear_acceleration_m_s2 = GetVector3(&in);
-  SkipDoubles(&in, 9);
-  if (!in.ok()) return Truncated("sensor_msgs/msg/Imu");
-  return Status::Ok();
+  return Decode(cdr, "sensor_msgs/msg/Imu", imu, [](Cdr* in, RosImu* m) {
+    in->Header(&m->stamp_ns, &m->frame_id);
+    m->orientation = GetQuaternion(in);
+    SkipDoubles(in, 9);
+    m->angular_velocity_rad_s = GetVector3(in);
+    SkipDoubles(in, 9);
+    m->linear_acceleration_m_s2 = GetVector3(in);
+    SkipDoubles(in, 9);
+  });
 }
 
 Status DecodeOdometry(const std::vector<uint8_t>& cdr, RosOdometry* odometry) {
-  Cdr in(cdr);
-  *odometry = RosOdometry();
-  in.Header(&odometry->stamp_ns, &odometry->frame_id);
-  odometry->child_frame_id = in.String();
-  odometry->position_m = GetVector3(&in);
-  odometry->orientation = GetQuaternion(&in);
-  SkipDoubles(&in, 36);
-  odometry->linear_m_s = GetVector3(&in);
-  odometry->angular_rad_s = GetVector3(&in);
-  SkipDoubles(&in, 36);
-  if (!in.ok()) return Truncated("nav_msgs/msg/Odometry");
-  return Status::Ok();
+  return Decode(cdr, "nav_msgs/msg/Odometry", odometry, [](Cdr* in, RosOdometry* m) {
+    in->Header(&m->stamp_ns, &m->frame_id);
+    m->child_frame_id = in->String();
+    m->position_m = GetVector3(in);
+    m->orientation = GetQuaternion(in);
+    SkipDoubles(in, 36);
+    m->linear_m_s = GetVector3(in);
+    m->angular_rad_s = GetVector3(in);
+    SkipDoubles(in, 36);
+  });
 }
 
 Status DecodePointCloud2(const std::vector<uint8_t>& cdr, RosPointCloud* cloud) {
-  Cdr in(cdr);
-  *cloud = RosPointCloud();
-  in.Header(&cloud->stamp_ns, &cloud->frame_id);
-  cloud->height = in.Get<uint32_t>();
-  cloud->width = in.Get<uint32_t>();
-  const uint32_t fields = in.Get<uint32_t>();
-  for (uint32_t k = 0; in.ok() && k < fields; ++k) {
-    RosPointField f;
-    f.name = in.String();
-    f.offset = in.Get<uint32_t>();
-    f.datatype = in.Get<uint8_t>();
-    f.count = in.Get<uint32_t>();
-    cloud->fields.push_back(f);
-  }
-  cloud->big_endian = in.Get<uint8_t>() != 0;
-  cloud->point_step = in.Get<uint32_t>();
-  cloud->row_step = in.Get<uint32_t>();
-  cloud->data = in.Bytes();
-  cloud->dense = in.Get<uint8_t>() != 0;
-  if (!in.ok()) return Truncated("sensor_msgs/msg/PointCloud2");
-  return Status::Ok();
+  return Decode(cdr, "sensor_msgs/msg/PointCloud2", cloud, [](Cdr* in, RosPointCloud* m) {
+    in->Header(&m->stamp_ns, &m->frame_id);
+    m->height = in->Get<uint32_t>();
+    m->width = in->Get<uint32_t>();
+    const uint32_t fields = in->Get<uint32_t>();
+    for (uint32_t k = 0; in->ok() && k < fields; ++k) {
+      RosPointField f;
+      f.name = in->String();
+      f.offset = in->Get<uint32_t>();
+      f.datatype = in->Get<uint8_t>();
+      f.count = in->Get<uint32_t>();
+      m->fields.push_back(f);
+    }
+    m->big_endian = in->Get<uint8_t>() != 0;
+    m->point_step = in->Get<uint32_t>();
+    m->row_step = in->Get<uint32_t>();
+    m->data = in->Bytes();
+    m->dense = in->Get<uint8_t>() != 0;
+  });
 }
 
 Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* out) {

@@ -46,14 +46,20 @@ const char* const kReaders[8] = {"velodyne",    "oxts",        "timestamps", "ca
 
 namespace {
 
+// A decoder's error must name the message type it decoded.
+void ExpectTypeNamed(const std::string& reader, const std::string& path, const Status& status,
+                     const std::string& type) {
+  if (!status.ok() && status.message().find(type) == std::string::npos) {
+    Broken(reader, path, type + " error does not name the type: " + status.message());
+  }
+}
+
 // A CDR message decoded as each message type: each decoder either names the message type in its
 // error or returns sizes that its data holds, and only finite points.
 void CheckCdr(const std::string& reader, const std::string& path, const std::vector<uint8_t>& cdr) {
   RosImage image;
   Status status = DecodeImage(cdr, &image);
-  if (!status.ok() && status.message().find("sensor_msgs/msg/Image") == std::string::npos) {
-    Broken(reader, path, "image error does not name the type: " + status.message());
-  }
+  ExpectTypeNamed(reader, path, status, "sensor_msgs/msg/Image");
   if (status.ok() && uint64_t{image.step} * image.height > image.data.size()) {
     Broken(reader, path, "image rows past its data accepted");
   }
@@ -66,31 +72,17 @@ void CheckCdr(const std::string& reader, const std::string& path, const std::vec
   }
   int64_t stamp_ns = 0;
   cv::Mat decoded;
-  status = DecodeCompressedImage(cdr, &stamp_ns, &decoded);
-  if (!status.ok() &&
-      status.message().find("sensor_msgs/msg/CompressedImage") == std::string::npos) {
-    Broken(reader, path, "compressed image error does not name the type: " + status.message());
-  }
+  ExpectTypeNamed(reader, path, DecodeCompressedImage(cdr, &stamp_ns, &decoded),
+                  "sensor_msgs/msg/CompressedImage");
   RosCameraInfo info;
-  status = DecodeCameraInfo(cdr, &info);
-  if (!status.ok() && status.message().find("sensor_msgs/msg/CameraInfo") == std::string::npos) {
-    Broken(reader, path, "camera info error does not name the type: " + status.message());
-  }
+  ExpectTypeNamed(reader, path, DecodeCameraInfo(cdr, &info), "sensor_msgs/msg/CameraInfo");
   RosImu imu;
-  status = DecodeImu(cdr, &imu);
-  if (!status.ok() && status.message().find("sensor_msgs/msg/Imu") == std::string::npos) {
-    Broken(reader, path, "imu error does not name the type: " + status.message());
-  }
+  ExpectTypeNamed(reader, path, DecodeImu(cdr, &imu), "sensor_msgs/msg/Imu");
   RosOdometry odometry;
-  status = DecodeOdometry(cdr, &odometry);
-  if (!status.ok() && status.message().find("nav_msgs/msg/Odometry") == std::string::npos) {
-    Broken(reader, path, "odometry error does not name the type: " + status.message());
-  }
+  ExpectTypeNamed(reader, path, DecodeOdometry(cdr, &odometry), "nav_msgs/msg/Odometry");
   RosPointCloud cloud;
   status = DecodePointCloud2(cdr, &cloud);
-  if (!status.ok() && status.message().find("sensor_msgs/msg/PointCloud2") == std::string::npos) {
-    Broken(reader, path, "cloud error does not name the type: " + status.message());
-  }
+  ExpectTypeNamed(reader, path, status, "sensor_msgs/msg/PointCloud2");
   CloudPoints points;
   if (status.ok() && uint64_t{cloud.width} * cloud.height <= (1u << 22) &&
       ExtractCloudPoints(cloud, &points).ok()) {
