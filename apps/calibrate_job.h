@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "core/io/bag_drive.h"
 #include "core/online/convergence.h"
 #include "core/online/frame_source.h"
 #include "core/online/online_calibrator.h"
@@ -14,6 +15,7 @@ namespace stcalib::cli {
 // One run of `stcalib calibrate` (also what `stcalib demo` runs).
 struct CalibrateJob {
   std::string drive_dir, calib_dir, init_calib, out_dir;
+  BagDriveOptions bag;  ///< a ROS 2 bag instead of the drive when bag.bag_dir is set
   double perturb_rot_deg = 0, perturb_trans_m = 0, perturb_time_s = 0;
   uint64_t seed = 1;
   int first_frame = 0, num_frames = 0;
@@ -32,7 +34,7 @@ struct CalibrateOutcome {
   std::string reason;
   bool has_truth = false;
   std::string reference;  ///< "ground truth (simulated)" or "drive calibration"
-  std::string motion;     ///< where Tv comes from: "oxts" or "scan_registration"
+  std::string motion;     ///< where Tv comes from: DriveMotion::SourceName
   CalibrationState reference_state, initial, estimate;
   CalibrationError error, initial_error;
   std::vector<FrameReport> reports;

@@ -97,6 +97,12 @@ CalibrateJob CalibrateJobFromFlags() {
   job.drive_dir = FLAGS_drive;
   job.calib_dir = FLAGS_calib_dir;
   job.init_calib = FLAGS_init_calib;
+  job.bag.bag_dir = FLAGS_bag;
+  job.bag.image_topic = FLAGS_image_topic;
+  job.bag.cloud_topic = FLAGS_cloud_topic;
+  job.bag.camera_info_topic = FLAGS_camera_info_topic;
+  job.bag.odom_topic = FLAGS_odom_topic;
+  job.bag.require_tf_extrinsic = FLAGS_init_calib.empty();
   job.out_dir = FLAGS_out;
   job.perturb_rot_deg = FLAGS_perturb_rot_deg;
   job.perturb_trans_m = FLAGS_perturb_trans_m;
@@ -174,7 +180,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   if (status.ok()) status = job.convergence.Validate();
   if (!status.ok()) return UsageError(kCommand, status.message());
   Drive drive;
-  status = OpenDrive(job.drive_dir, job.calib_dir, &drive);
+  status = job.bag.bag_dir.empty() ? OpenDrive(job.drive_dir, job.calib_dir, &drive)
+                                   : OpenBagDrive(job.bag, &drive);
   if (!status.ok()) return ReportError(kCommand, status);
   const int first = job.first_frame;
   const int last =
@@ -193,7 +200,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     outcome->reference = "ground truth (simulated)";
   } else {
     outcome->reference_state.T_camera_lidar = drive.T_camera_lidar;
-    outcome->reference = "drive calibration (" + drive.calib_dir + "/calib_velo_to_cam.txt)";
+    outcome->reference = drive.store ? "drive calibration (" + drive.drive_dir + ": /tf_static)"
+                                     : "drive calibration (" + drive.calib_dir +
+                                           "/calib_velo_to_cam.txt)";
   }
   CalibrationState initial;
   std::mt19937_64 rng(job.seed);
@@ -216,8 +225,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   std::unique_ptr<DriveFrameSource> source;
   status = DriveFrameSource::Create(&drive, source_options, &source);
   if (!status.ok()) return ReportError(kCommand, status);
-  outcome->motion =
-      source->motion().source() == DriveMotion::Source::kOxts ? "oxts" : "scan_registration";
+  outcome->motion = source->motion().SourceName();
 
   std::error_code ec;
   if (!job.out_dir.empty()) {
@@ -544,6 +552,11 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
 }
 
 std::string CalibrateFlagsError() {
+  // --bag wins over a --drive (which a flagfile may have set).
+  if (FLAGS_bag.empty() && FLAGS_drive.empty()) return "give --drive or --bag";
+  if (!FLAGS_bag.empty() && (FLAGS_image_topic.empty() || FLAGS_cloud_topic.empty())) {
+    return "--bag needs --image_topic and --cloud_topic";
+  }
   for (const auto& [name, value] : {std::pair{"--loss", &FLAGS_loss}}) {
     RefineOptions::Loss loss;
     if (!ParseLoss(*value, &loss)) return std::string(name) + " must be " + LossChoices();

@@ -23,6 +23,7 @@ int RunCalibrate();
 int RunDemo();
 int RunEvalTemporal();
 int RunCheck();
+int RunConvert();
 
 // Prints "stcalib <command>: error: <message>" to stderr and returns kExitFailure.
 int ReportError(const std::string& command, const Status& status);

@@ -6,6 +6,11 @@
 // subcommand that uses it; core/ never sees gflags.
 DECLARE_string(drive);
 DECLARE_string(calib_dir);
+DECLARE_string(bag);
+DECLARE_string(image_topic);
+DECLARE_string(cloud_topic);
+DECLARE_string(camera_info_topic);
+DECLARE_string(odom_topic);
 DECLARE_int32(frame);
 DECLARE_string(out);
 DECLARE_int32(frames);

@@ -50,7 +50,8 @@ const std::vector<Subcommand>& Subcommands() {
        &RunFeatures,
        {"drive", "frame", "out", "calib_dir", "detector"}},
       {"calibrate",
-       "--drive=DRIVE_DIR [--calib_dir=DIR] [--init_calib=FILE] [--perturb_rot_deg=D] "
+       "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T "
+       "[--camera_info_topic=T] [--odom_topic=T]) [--init_calib=FILE] [--perturb_rot_deg=D] "
        "[--perturb_trans_m=M] [--perturb_time_s=S] [--init_uncertainty=DEG,M,S] [--seed=S] "
        "[--first_frame=I] [--num_frames=N] [--out=DIR] [--flagfile=configs/X.flags]",
        "online calibration of rotation, translation and time offset; with --out writes the "
@@ -58,7 +59,9 @@ const std::vector<Subcommand>& Subcommands() {
        "only when converged",
        &RunCalibrate,
        {"drive",
-        "calib_dir",
+        "bag",
+        "image_topic",
+        "cloud_topic",
         "init_calib",
         "out",
         "first_frame",
@@ -72,8 +75,6 @@ const std::vector<Subcommand>& Subcommands() {
         "time_offset_bound_s",
         "prior_sigma_translation_m",
         "window_frames",
-        "refine_frames",
-        "local_map_sweeps",
         "detector",
         "remove_dynamic",
         "polish"}},
@@ -95,6 +96,12 @@ const std::vector<Subcommand>& Subcommands() {
        &RunCheck,
        {"drive", "calib_dir", "init_calib", "perturb_rot_deg", "perturb_trans_m", "perturb_time_s",
         "seed", "first_frame", "num_frames", "out", "min_health"}},
+      {"convert",
+       "--drive=DRIVE_DIR [--calib_dir=DIR] --bag=OUT_DIR",
+       "a drive written as a ROS 2 bag (MCAP): image, camera info, cloud with rings and point "
+       "times, odometry from the oxts, /tf_static; calibrate --bag reads it back",
+       &RunConvert,
+       {"drive", "calib_dir", "bag"}},
       {"demo",
        "[--out=DIR] [--seed=S]",
        "simulate a drive (true time offset +30 ms), calibrate it from +-2 deg / +-5 cm, print "

@@ -21,8 +21,12 @@ LidarFrameFeatures ComputeLidarSweepBase(LidarScan scan, double stamp_s, double 
   LidarFrameFeatures f;
   f.scan = std::move(scan);
   f.stamp_s = stamp_s;
-  f.rings = SplitIntoRings(f.scan.points_lidar);
-  f.point_time_s = PointTimesFromAzimuth(f.rings, sweep_duration_s);
+  // A driver's rings and capture times, when the sweep carries them, over KITTI's derivations.
+  f.rings = f.scan.ring.empty() ? SplitIntoRings(f.scan.points_lidar)
+                                : RingsFromLabels(f.scan.points_lidar, f.scan.ring);
+  // (The driver's times move here: the scan keeps no second copy.)
+  f.point_time_s = f.scan.point_time_s.empty() ? PointTimesFromAzimuth(f.rings, sweep_duration_s)
+                                               : std::move(f.scan.point_time_s);
   f.deskewed = DeskewToStamp(f.scan.points_lidar, f.point_time_s, stamp_s, T_world_lidar);
   f.ground_plane = FitGroundPlane(f.deskewed, options.ground);
   f.ground = GroundMask(f.deskewed, f.ground_plane, options.ground.band_m);
@@ -123,7 +127,7 @@ Status SweepCache::Base(size_t frame, const LidarFrameFeatures** features) {
     STCALIB_RETURN_IF_ERROR(drive_.CheckFrame(frame));
     LidarScan scan;
     STCALIB_RETURN_IF_ERROR(drive_.LoadScan(frame, &scan));
-    if (scan.size() == 0) LOG(WARNING) << drive_.VelodynePath(frame) << ": empty sweep";
+    if (scan.size() == 0) LOG(WARNING) << drive_.ScanName(frame) << ": empty sweep";
     const double stamp = motion_.Seconds(drive_.lidar_stamps_ns[frame]);
     ++sweeps_loaded_;
     it = base_
@@ -273,11 +277,12 @@ Status SweepCache::LocalMap(size_t frame, const LocalMapOptions& map_options, Li
           (result.T_target_source.translation() - T.translation()).norm());
       T = result.T_target_source;
     }
-    // Poses from the oxts, looked up at the LiDAR stamps, are off with δ; NDT and a motion from
-    // scan registration relate the sweeps themselves, so their relative pose holds at any δ.
+    // Poses from the oxts (or odometry), looked up at the LiDAR stamps, are off with δ; NDT and a
+    // motion from scan registration relate the sweeps themselves, so their relative pose holds at
+    // any δ.
     SweepInMap sweep{&sweeps[k]->edges, T};
     sweep.age = ages[k];
-    if (!map_options.use_ndt && motion_.source() == DriveMotion::Source::kOxts) {
+    if (!map_options.use_ndt && motion_.measured()) {
       sweep.offset_rate =
           RelativeLidarPoseRate(motion_.PoseFunction(), current.stamp_s, sweeps[k]->stamp_s);
     }

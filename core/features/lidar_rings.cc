@@ -1,5 +1,7 @@
 #include "core/features/lidar_rings.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -8,7 +10,10 @@
 
 namespace stcalib {
 
-ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points) {
+namespace {
+
+// Azimuth and range of every point.
+ScanRings PolarCoordinates(const std::vector<Eigen::Vector3d>& points) {
   ScanRings rings;
   const int n = static_cast<int>(points.size());
   rings.ring.resize(n);
@@ -19,19 +24,12 @@ ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points) {
     rings.azimuth_rad[i] = static_cast<float>(FastAtan2(points[i].y(), points[i].x()));
     rings.range_m[i] = static_cast<float>(points[i].norm());
   }
-  rings.ring_begin.push_back(0);
-  bool passed_back = false;  // the current laser has swept past the rear
-  for (int i = 1; i < n; ++i) {
-    const float a0 = rings.azimuth_rad[i - 1], a1 = rings.azimuth_rad[i];
-    if (a1 < a0 - static_cast<float>(M_PI / 2)) passed_back = true;  // wrap or rear gap
-    if (passed_back && a0 < 0 && a1 >= 0) {
-      rings.ring_begin.push_back(i);
-      passed_back = false;
-    }
-  }
-  rings.ring_begin.push_back(n);
-  if (n == 0) rings.ring_begin = {0};
+  return rings;
+}
 
+// Given ring_begin: each point's ring, the azimuth step, the elevations and their order.
+void DescribeRings(const std::vector<Eigen::Vector3d>& points, ScanRings* rings_out) {
+  ScanRings& rings = *rings_out;
   std::vector<double> steps, elevation(rings.num_rings(), 0.0);
   for (int r = 0; r < rings.num_rings(); ++r) {
     double sum = 0;
@@ -60,6 +58,41 @@ ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points) {
                    [&](int a, int b) { return elevation[a] > elevation[b]; });
   rings.elevation_rank.resize(rings.num_rings());
   for (int k = 0; k < rings.num_rings(); ++k) rings.elevation_rank[rings.order_by_elevation[k]] = k;
+}
+
+}  // namespace
+
+ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points) {
+  ScanRings rings = PolarCoordinates(points);
+  const int n = static_cast<int>(points.size());
+  rings.ring_begin.push_back(0);
+  bool passed_back = false;  // the current laser has swept past the rear
+  for (int i = 1; i < n; ++i) {
+    const float a0 = rings.azimuth_rad[i - 1], a1 = rings.azimuth_rad[i];
+    if (a1 < a0 - static_cast<float>(M_PI / 2)) passed_back = true;  // wrap or rear gap
+    if (passed_back && a0 < 0 && a1 >= 0) {
+      rings.ring_begin.push_back(i);
+      passed_back = false;
+    }
+  }
+  rings.ring_begin.push_back(n);
+  if (n == 0) rings.ring_begin = {0};
+  DescribeRings(points, &rings);
+  return rings;
+}
+
+ScanRings RingsFromLabels(const std::vector<Eigen::Vector3d>& points,
+                          const std::vector<uint16_t>& ring_of_point) {
+  CHECK_EQ(points.size(), ring_of_point.size());
+  ScanRings rings = PolarCoordinates(points);
+  const int n = static_cast<int>(points.size());
+  rings.ring_begin.push_back(0);
+  for (int i = 1; i < n; ++i) {
+    if (ring_of_point[i] != ring_of_point[i - 1]) rings.ring_begin.push_back(i);
+  }
+  rings.ring_begin.push_back(n);
+  if (n == 0) rings.ring_begin = {0};
+  DescribeRings(points, &rings);
   return rings;
 }
 

@@ -25,6 +25,11 @@ struct ScanRings {
 };
 
 ScanRings SplitIntoRings(const std::vector<Eigen::Vector3d>& points_lidar);
+// The same for a sweep whose driver gave each point its ring: `ring_of_point` (one per point,
+// grouped: non-decreasing) starts a new ring wherever it changes; the rings are numbered in that
+// order from 0.
+ScanRings RingsFromLabels(const std::vector<Eigen::Vector3d>& points_lidar,
+                          const std::vector<uint16_t>& ring_of_point);
 
 // Capture time of every point relative to the sweep stamp, which KITTI puts mid-sweep when the
 // head faces forward; the head spins clockwise, so t = −azimuth / 2π · sweep_duration [s].

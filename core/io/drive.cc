@@ -71,6 +71,10 @@ std::string Drive::LabelsPath(size_t frame) const {
   return drive_dir + "/velodyne_points/labels/" + frame_names.at(frame) + ".bin";
 }
 
+std::string Drive::ScanName(size_t frame) const {
+  return store ? store->ScanName(frame) : VelodynePath(frame);
+}
+
 Status Drive::CheckFrame(size_t frame) const {
   if (frame >= NumFrames()) {
     return Status::Error(drive_dir + ": frame " + std::to_string(frame) + " out of range (" +
@@ -81,11 +85,13 @@ Status Drive::CheckFrame(size_t frame) const {
 
 Status Drive::LoadImage(size_t frame, cv::Mat* image_bgr) const {
   STCALIB_RETURN_IF_ERROR(CheckFrame(frame));
+  if (store) return store->LoadImage(frame, image_bgr);
   return ReadImage(ImagePath(frame), image_bgr);
 }
 
 Status Drive::LoadScan(size_t frame, LidarScan* scan) const {
   STCALIB_RETURN_IF_ERROR(CheckFrame(frame));
+  if (store) return store->LoadScan(frame, scan);
   return ReadVelodyneBin(VelodynePath(frame), scan);
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -12,6 +13,25 @@
 #include "core/types/transform.h"
 
 namespace stcalib {
+
+// Where a drive's images and sweeps come from when they are not KITTI files (a ROS 2 bag,
+// core/io/bag_drive.h).
+class FrameStore {
+ public:
+  virtual ~FrameStore() = default;
+  virtual Status LoadImage(size_t frame, cv::Mat* image_bgr) const = 0;
+  virtual Status LoadScan(size_t frame, LidarScan* scan) const = 0;
+  virtual std::string ScanName(size_t frame) const = 0;  ///< names the sweep in messages
+};
+
+// One sample of the vehicle's motion from odometry: the body's pose in a world frame, its
+// velocity in that world and its angular rates in the body frame.
+struct OdometrySample {
+  StampNs stamp_ns = 0;
+  Rigid3d T_world_body = Rigid3d::Identity();
+  Eigen::Vector3d velocity_world_m_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rate_body_rad_s = Eigen::Vector3d::Zero();
+};
 
 // A KITTI raw synced drive: image_02/, velodyne_points/ and (optionally) oxts/, each with data/
 // and timestamps.txt, plus the three calibration files in `calib_dir` (by default the drive's
@@ -36,10 +56,16 @@ struct Drive {
   std::vector<StampNs> oxts_stamps_ns;  ///< oxts/timestamps.txt
   std::vector<OxtsPacket> oxts;         ///< one packet per frame
 
+  // A bag's odometry instead of oxts (the body is the frame T_lidar_imu places, "imu" above).
+  std::vector<OdometrySample> odometry;
+  // Set for a drive read from a bag: its images and sweeps come from there, not from files.
+  std::shared_ptr<const FrameStore> store;
+
   size_t NumFrames() const { return frame_names.size(); }
   std::string ImagePath(size_t frame) const;
   std::string VelodynePath(size_t frame) const;
   std::string LabelsPath(size_t frame) const;  ///< simulated drives only
+  std::string ScanName(size_t frame) const;    ///< the .bin path, or the store's name for it
   Status LoadImage(size_t frame, cv::Mat* image_bgr) const;
   Status LoadScan(size_t frame, LidarScan* scan) const;
   // Checks `frame` against the number of frames; the error names the drive.

@@ -49,6 +49,12 @@ struct CameraCalibration {
   int image_width = 0;   ///< from S_rect_02 [px]
   int image_height = 0;  ///< from S_rect_02 [px]
   KittiCalibFile file;   ///< every key of the file
+  // A camera whose images are raw, not rectified (a bag's CameraInfo): its model ("plumb_bob",
+  // "rational_polynomial", "equidistant"), matrix and coefficients, which RectifyImage
+  // (core/io/image.h) undoes onto P_rect_02. Empty model: the images are rectified (KITTI's).
+  std::string distortion_model;
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  std::vector<double> distortion;
 };
 
 Status ReadCamToCam(const std::string& path, CameraCalibration* calibration);

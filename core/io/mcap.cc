@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <sstream>
 
 namespace stcalib {
 namespace {
@@ -228,18 +229,21 @@ class Reader {
   bool malformed_ = false;
 };
 
-// Walks the records of `bytes` after the leading magic. A record that runs past the end, or a
-// file without its closing records, stops the walk with `stopped` set.
-Status Walk(const uint8_t* bytes, size_t size, Reader* reader, McapSummary* summary) {
-  size_t at = sizeof(kMagic);
+// Walks the records of a file of `size` bytes after the leading magic, reading one record at a
+// time (a bag is read in the memory of its largest record, not of the file). A record that runs
+// past the end, or a file without its closing records, stops the walk with `stopped` set.
+Status Walk(std::istream& in, uint64_t size, Reader* reader, McapSummary* summary) {
+  uint64_t at = sizeof(kMagic);
+  std::vector<uint8_t> content;
   while (true) {
-    if (size - at < 9) {
+    uint8_t head[9];
+    if (size - at < 9 || !in.read(reinterpret_cast<char*>(head), 9)) {
       summary->stopped = "stopped at byte " + std::to_string(at) +
                          ": the file ends before its data section does (truncated)";
       return Status::Ok();
     }
-    const uint8_t opcode = bytes[at];
-    Fields header(bytes + at + 1, 8);
+    const uint8_t opcode = head[0];
+    Fields header(head + 1, 8);
     uint64_t length;
     header.U64(&length);
     if (length > size - at - 9) {
@@ -248,8 +252,13 @@ Status Walk(const uint8_t* bytes, size_t size, Reader* reader, McapSummary* summ
                          std::to_string(size - at - 9) + " left): truncated";
       return Status::Ok();
     }
+    content.resize(static_cast<size_t>(length));
+    if (!in.read(reinterpret_cast<char*>(content.data()), static_cast<std::streamsize>(length))) {
+      summary->stopped = "stopped at byte " + std::to_string(at) + ": reading the file failed";
+      return Status::Ok();
+    }
     bool end = false;
-    const Status status = reader->Record(opcode, bytes + at + 9, static_cast<size_t>(length), &end);
+    const Status status = reader->Record(opcode, content.data(), content.size(), &end);
     if (!status.ok()) {
       if (reader->malformed()) {
         summary->stopped = "stopped at byte " + std::to_string(at) + ": " + status.message();
@@ -259,8 +268,20 @@ Status Walk(const uint8_t* bytes, size_t size, Reader* reader, McapSummary* summ
       return Status::Ok();
     }
     if (end) return Status::Ok();
-    at += 9 + static_cast<size_t>(length);
+    at += 9 + length;
   }
+}
+
+// The magic and version at the start of a file.
+Status CheckMagic(const uint8_t* magic, size_t n, const std::string& name) {
+  if (n < sizeof(kMagic) || std::memcmp(magic, kMagic, 5) != 0) {
+    return Status::Error(name + ": not an MCAP file (no MCAP magic at its start)");
+  }
+  if (magic[5] != kMagic[5]) {
+    return Status::Error(name + ": MCAP major version '" + std::string(1, magic[5]) +
+                         "' is not supported (only '0')");
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -268,23 +289,108 @@ Status Walk(const uint8_t* bytes, size_t size, Reader* reader, McapSummary* summ
 Status ParseMcap(const std::vector<uint8_t>& bytes, const std::string& name,
                  const McapVisitor& visit, McapSummary* summary) {
   *summary = McapSummary();
-  if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, 5) != 0) {
-    return Status::Error(name + ": not an MCAP file (no MCAP magic at its start)");
-  }
-  if (bytes[5] != kMagic[5]) {
-    return Status::Error(name + ": MCAP major version '" + std::string(1, bytes[5]) +
-                         "' is not supported (only '0')");
-  }
+  STCALIB_RETURN_IF_ERROR(CheckMagic(bytes.data(), bytes.size(), name));
+  std::istringstream in(std::string(bytes.begin(), bytes.end()));
+  in.seekg(sizeof(kMagic));
   Reader reader(name, visit, summary);
-  return Walk(bytes.data(), bytes.size(), &reader, summary);
+  return Walk(in, bytes.size(), &reader, summary);
 }
 
 Status ReadMcap(const std::string& path, const McapVisitor& visit, McapSummary* summary) {
-  std::ifstream in(path, std::ios::binary);
+  *summary = McapSummary();
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) return Status::Error(path + ": cannot open the MCAP file");
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
-                             std::istreambuf_iterator<char>());
-  return ParseMcap(bytes, path, visit, summary);
+  const uint64_t size = static_cast<uint64_t>(in.tellg());
+  in.seekg(0);
+  uint8_t magic[sizeof(kMagic)] = {};
+  in.read(reinterpret_cast<char*>(magic), sizeof(magic));
+  STCALIB_RETURN_IF_ERROR(CheckMagic(magic, static_cast<size_t>(in.gcount()), path));
+  Reader reader(path, visit, summary);
+  return Walk(in, size, &reader, summary);
+}
+
+namespace {
+
+// Appends little-endian integers and length-prefixed strings and bytes, as MCAP records hold them.
+class Appender {
+ public:
+  explicit Appender(std::vector<uint8_t>* out) : out_(out) {}
+  template <typename T>
+  Appender& Int(T value) {
+    for (size_t k = 0; k < sizeof(T); ++k) out_->push_back(static_cast<uint8_t>(value >> (8 * k)));
+    return *this;
+  }
+  Appender& String(const std::string& s) {
+    Int(static_cast<uint32_t>(s.size()));
+    out_->insert(out_->end(), s.begin(), s.end());
+    return *this;
+  }
+
+ private:
+  std::vector<uint8_t>* out_;
+};
+
+}  // namespace
+
+McapWriter::~McapWriter() {
+  if (out_.is_open()) Close();
+}
+
+Status McapWriter::Open(const std::string& path) {
+  path_ = path;
+  out_.open(path, std::ios::binary | std::ios::trunc);
+  if (!out_) return Status::Error(path + ": cannot create the MCAP file");
+  out_.write(reinterpret_cast<const char*>(kMagic), sizeof(kMagic));
+  std::vector<uint8_t> header;
+  Appender(&header).String("ros2").String("stcalib");
+  Record(kHeader, header);
+  return Status::Ok();
+}
+
+void McapWriter::Record(uint8_t opcode, const std::vector<uint8_t>& content) {
+  std::vector<uint8_t> head;
+  Appender(&head).Int(opcode).Int(static_cast<uint64_t>(content.size()));
+  out_.write(reinterpret_cast<const char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  out_.write(reinterpret_cast<const char*>(content.data()),
+             static_cast<std::streamsize>(content.size()));
+}
+
+uint16_t McapWriter::AddSchema(const std::string& name, const std::string& ros2msg_definition) {
+  const uint16_t id = next_schema_++;
+  std::vector<uint8_t> content;
+  Appender(&content).Int(id).String(name).String("ros2msg").String(ros2msg_definition);
+  Record(kSchema, content);
+  return id;
+}
+
+uint16_t McapWriter::AddChannel(uint16_t schema_id, const std::string& topic) {
+  const uint16_t id = next_channel_++;
+  std::vector<uint8_t> content;
+  Appender(&content).Int(id).Int(schema_id).String(topic).String("cdr").Int(uint32_t{0});
+  Record(kChannel, content);
+  return id;
+}
+
+void McapWriter::Write(uint16_t channel_id, uint64_t log_time_ns, const std::vector<uint8_t>& cdr) {
+  std::vector<uint8_t> content;
+  content.reserve(22 + cdr.size());
+  Appender(&content).Int(channel_id).Int(sequence_[channel_id]++).Int(log_time_ns).Int(log_time_ns);
+  content.insert(content.end(), cdr.begin(), cdr.end());
+  Record(kMessage, content);
+  ++messages_;
+}
+
+Status McapWriter::Close() {
+  if (!out_.is_open()) return Status::Ok();
+  std::vector<uint8_t> data_end, footer;
+  Appender(&data_end).Int(uint32_t{0});  // data section CRC: not computed
+  Record(kDataEnd, data_end);
+  Appender(&footer).Int(uint64_t{0}).Int(uint64_t{0}).Int(uint32_t{0});  // no summary section
+  Record(kFooter, footer);
+  out_.write(reinterpret_cast<const char*>(kMagic), sizeof(kMagic));
+  out_.close();
+  if (!out_) return Status::Error(path_ + ": writing the MCAP file failed (disk full?)");
+  return Status::Ok();
 }
 
 }  // namespace stcalib

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <string>
@@ -45,7 +46,8 @@ struct McapSummary {
 // channel before its first message).
 using McapVisitor = std::function<void(const McapChannel&, const McapMessage&)>;
 
-// Reads `path` (whole, into memory) from start to end. Errors name the file: missing, not an MCAP
+// Reads `path` from start to end, one record at a time (its memory is the largest record's: a
+// chunk, or a message outside chunks). Errors name the file: missing, not an MCAP
 // file (its magic), an unsupported major version or chunk compression, a message on an unknown
 // channel. A file cut short or with a record that runs past its end is not an error: the messages
 // before the fault are delivered and `summary->stopped` says at which byte and why.
@@ -54,5 +56,32 @@ Status ReadMcap(const std::string& path, const McapVisitor& visit, McapSummary* 
 // The same over bytes in memory; `name` stands for the file in messages.
 Status ParseMcap(const std::vector<uint8_t>& bytes, const std::string& name,
                  const McapVisitor& visit, McapSummary* summary);
+
+// Writes an MCAP file for ROS 2 (profile "ros2"): the schemas and channels, then each message as
+// a record of the data section, unchunked and uncompressed, then DataEnd and a Footer without a
+// summary section (readers that need one scan the file; the CRCs are zero, "not computed").
+class McapWriter {
+ public:
+  McapWriter() = default;
+  McapWriter(const McapWriter&) = delete;
+  McapWriter& operator=(const McapWriter&) = delete;
+  ~McapWriter();
+  Status Open(const std::string& path);
+  // A ROS 2 message type ("sensor_msgs/msg/Image") with its definition in ros2msg text.
+  uint16_t AddSchema(const std::string& name, const std::string& ros2msg_definition);
+  uint16_t AddChannel(uint16_t schema_id, const std::string& topic);  ///< CDR messages
+  void Write(uint16_t channel_id, uint64_t log_time_ns, const std::vector<uint8_t>& cdr);
+  // Closes the data section; an error names the file when any write failed.
+  Status Close();
+  uint64_t messages_written() const { return messages_; }
+
+ private:
+  void Record(uint8_t opcode, const std::vector<uint8_t>& content);
+  std::string path_;
+  std::ofstream out_;
+  uint16_t next_schema_ = 1, next_channel_ = 0;
+  std::map<uint16_t, uint32_t> sequence_;
+  uint64_t messages_ = 0;
+};
 
 }  // namespace stcalib

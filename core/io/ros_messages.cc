@@ -135,6 +135,12 @@ double FieldValue(const uint8_t* p, uint8_t datatype, bool big_endian) {
 
 }  // namespace
 
+Status DecodeHeader(const std::vector<uint8_t>& cdr, int64_t* stamp_ns, std::string* frame_id) {
+  Cdr in(cdr);
+  in.Header(stamp_ns, frame_id);
+  return in.ok() ? Status::Ok() : Truncated("std_msgs/msg/Header");
+}
+
 Status DecodeImage(const std::vector<uint8_t>& cdr, RosImage* image) {
   STCALIB_RETURN_IF_ERROR(Decode(cdr, "sensor_msgs/msg/Image", image, [](Cdr* in, RosImage* m) {
     in->Header(&m->stamp_ns, &m->frame_id);
@@ -353,6 +359,7 @@ Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* out) {
       }
       if (!point.allFinite()) continue;
       out->points.push_back(point);
+      if (cloud.height > 1) out->row.push_back(r);
       if (intensity) {
         out->intensity.push_back(static_cast<float>(
             FieldValue(p + intensity->offset, intensity->datatype, cloud.big_endian)));
@@ -375,6 +382,179 @@ Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* out) {
     }
   }
   return Status::Ok();
+}
+
+Status DecodeTfMessage(const std::vector<uint8_t>& cdr, std::vector<RosTransform>* transforms) {
+  return Decode(cdr, "tf2_msgs/msg/TFMessage", transforms,
+                [&](Cdr* in, std::vector<RosTransform>* m) {
+                  const uint32_t n = in->Get<uint32_t>();
+                  if (n > cdr.size() / 64) return in->Fail();  // each takes more than 64 bytes
+                  for (uint32_t k = 0; in->ok() && k < n; ++k) {
+                    RosTransform t;
+                    in->Header(&t.stamp_ns, &t.frame_id);
+                    t.child_frame_id = in->String();
+                    const Eigen::Vector3d translation = GetVector3(in);
+                    const Eigen::Quaterniond rotation = GetQuaternion(in);
+                    t.T_parent_child.linear() = rotation.normalized().toRotationMatrix();
+                    t.T_parent_child.translation() = translation;
+                    m->push_back(t);
+                  }
+                });
+}
+
+namespace {
+
+// Writes little-endian CDR (encapsulation 0x00 0x01), each primitive aligned to its size.
+class CdrWriter {
+ public:
+  CdrWriter() : bytes_{0, 1, 0, 0} {}
+  template <typename T>
+  CdrWriter& Put(T value) {
+    while ((bytes_.size() - 4) % sizeof(T) != 0) bytes_.push_back(0);
+    uint8_t raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));  // little-endian hosts only (x86, ARM)
+    bytes_.insert(bytes_.end(), raw, raw + sizeof(T));
+    return *this;
+  }
+  CdrWriter& String(const std::string& s) {
+    Put(static_cast<uint32_t>(s.size() + 1));
+    bytes_.insert(bytes_.end(), s.begin(), s.end());
+    bytes_.push_back(0);
+    return *this;
+  }
+  CdrWriter& Bytes(const std::vector<uint8_t>& data) {
+    Put(static_cast<uint32_t>(data.size()));
+    bytes_.insert(bytes_.end(), data.begin(), data.end());
+    return *this;
+  }
+  CdrWriter& Header(int64_t stamp_ns, const std::string& frame_id) {
+    const int64_t sec = stamp_ns >= 0 ? stamp_ns / 1000000000 : (stamp_ns - 999999999) / 1000000000;
+    Put(static_cast<int32_t>(sec));
+    Put(static_cast<uint32_t>(stamp_ns - sec * 1000000000));
+    return String(frame_id);
+  }
+  CdrWriter& Vector3(const Eigen::Vector3d& v) { return Put(v.x()).Put(v.y()).Put(v.z()); }
+  CdrWriter& Quaternion(const Eigen::Quaterniond& q) {
+    return Put(q.x()).Put(q.y()).Put(q.z()).Put(q.w());
+  }
+  CdrWriter& Zeros(int doubles) {
+    for (int k = 0; k < doubles; ++k) Put(0.0);
+    return *this;
+  }
+  std::vector<uint8_t> Take() { return std::move(bytes_); }
+
+ private:
+  std::vector<uint8_t> bytes_;
+};
+
+}  // namespace
+
+std::vector<uint8_t> EncodeImage(const RosImage& m) {
+  CdrWriter out;
+  out.Header(m.stamp_ns, m.frame_id).Put(m.height).Put(m.width).String(m.encoding);
+  out.Put(static_cast<uint8_t>(m.big_endian)).Put(m.step).Bytes(m.data);
+  return out.Take();
+}
+
+std::vector<uint8_t> EncodeCameraInfo(const RosCameraInfo& m) {
+  CdrWriter out;
+  out.Header(m.stamp_ns, m.frame_id).Put(m.height).Put(m.width).String(m.distortion_model);
+  out.Put(static_cast<uint32_t>(m.d.size()));
+  for (double d : m.d) out.Put(d);
+  for (int k = 0; k < 9; ++k) out.Put(m.K(k / 3, k % 3));
+  for (int k = 0; k < 9; ++k) out.Put(m.R(k / 3, k % 3));
+  for (int k = 0; k < 12; ++k) out.Put(m.P(k / 4, k % 4));
+  out.Put(uint32_t{0}).Put(uint32_t{0});                    // binning
+  for (int k = 0; k < 4; ++k) out.Put(uint32_t{0});         // roi
+  out.Put(uint8_t{0});                                      // roi.do_rectify
+  return out.Take();
+}
+
+std::vector<uint8_t> EncodePointCloud2(const RosPointCloud& m) {
+  CdrWriter out;
+  out.Header(m.stamp_ns, m.frame_id).Put(m.height).Put(m.width);
+  out.Put(static_cast<uint32_t>(m.fields.size()));
+  for (const RosPointField& f : m.fields) out.String(f.name).Put(f.offset).Put(f.datatype).Put(f.count);
+  out.Put(static_cast<uint8_t>(m.big_endian)).Put(m.point_step).Put(m.row_step).Bytes(m.data);
+  out.Put(static_cast<uint8_t>(m.dense));
+  return out.Take();
+}
+
+std::vector<uint8_t> EncodeOdometry(const RosOdometry& m) {
+  CdrWriter out;
+  out.Header(m.stamp_ns, m.frame_id).String(m.child_frame_id);
+  out.Vector3(m.position_m).Quaternion(m.orientation).Zeros(36);
+  out.Vector3(m.linear_m_s).Vector3(m.angular_rad_s).Zeros(36);
+  return out.Take();
+}
+
+std::vector<uint8_t> EncodeTfMessage(const std::vector<RosTransform>& transforms) {
+  CdrWriter out;
+  out.Put(static_cast<uint32_t>(transforms.size()));
+  for (const RosTransform& t : transforms) {
+    out.Header(t.stamp_ns, t.frame_id).String(t.child_frame_id);
+    out.Vector3(t.T_parent_child.translation());
+    out.Quaternion(Eigen::Quaterniond(t.T_parent_child.linear()));
+  }
+  return out.Take();
+}
+
+std::string Ros2MsgDefinition(const std::string& type) {
+  const std::string separator =
+      "\n================================================================================\nMSG: ";
+  const std::string header = separator + "std_msgs/Header\nbuiltin_interfaces/Time stamp\n"
+                                         "string frame_id" +
+                             separator + "builtin_interfaces/Time\nint32 sec\nuint32 nanosec";
+  const std::string vector3 = separator + "geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z";
+  const std::string quaternion = separator +
+                                 "geometry_msgs/Quaternion\nfloat64 x 0\nfloat64 y 0\n"
+                                 "float64 z 0\nfloat64 w 1";
+  if (type == "sensor_msgs/msg/Image") {
+    return "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\n"
+           "uint8 is_bigendian\nuint32 step\nuint8[] data" +
+           header;
+  }
+  if (type == "sensor_msgs/msg/CameraInfo") {
+    return "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\n"
+           "float64[] d\nfloat64[9] k\nfloat64[9] r\nfloat64[12] p\nuint32 binning_x\n"
+           "uint32 binning_y\nsensor_msgs/RegionOfInterest roi" +
+           header + separator +
+           "sensor_msgs/RegionOfInterest\nuint32 x_offset\nuint32 y_offset\nuint32 height\n"
+           "uint32 width\nbool do_rectify";
+  }
+  if (type == "sensor_msgs/msg/PointCloud2") {
+    return "std_msgs/Header header\nuint32 height\nuint32 width\nsensor_msgs/PointField[] fields\n"
+           "bool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense" +
+           header + separator +
+           "sensor_msgs/PointField\nuint8 INT8=1\nuint8 UINT8=2\nuint8 INT16=3\nuint8 UINT16=4\n"
+           "uint8 INT32=5\nuint8 UINT32=6\nuint8 FLOAT32=7\nuint8 FLOAT64=8\nstring name\n"
+           "uint32 offset\nuint8 datatype\nuint32 count";
+  }
+  if (type == "nav_msgs/msg/Odometry") {
+    return "std_msgs/Header header\nstring child_frame_id\n"
+           "geometry_msgs/PoseWithCovariance pose\ngeometry_msgs/TwistWithCovariance twist" +
+           header + separator +
+           "geometry_msgs/PoseWithCovariance\ngeometry_msgs/Pose pose\nfloat64[36] covariance" +
+           separator +
+           "geometry_msgs/Pose\ngeometry_msgs/Point position\n"
+           "geometry_msgs/Quaternion orientation" +
+           separator + "geometry_msgs/Point\nfloat64 x\nfloat64 y\nfloat64 z" + quaternion +
+           separator +
+           "geometry_msgs/TwistWithCovariance\ngeometry_msgs/Twist twist\nfloat64[36] covariance" +
+           separator +
+           "geometry_msgs/Twist\ngeometry_msgs/Vector3 linear\ngeometry_msgs/Vector3 angular" +
+           vector3;
+  }
+  if (type == "tf2_msgs/msg/TFMessage") {
+    return "geometry_msgs/TransformStamped[] transforms" + separator +
+           "geometry_msgs/TransformStamped\nstd_msgs/Header header\nstring child_frame_id\n"
+           "geometry_msgs/Transform transform" +
+           header + separator +
+           "geometry_msgs/Transform\ngeometry_msgs/Vector3 translation\n"
+           "geometry_msgs/Quaternion rotation" +
+           vector3 + quaternion;
+  }
+  return "";
 }
 
 }  // namespace stcalib

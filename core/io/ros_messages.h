@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/types/status.h"
+#include "core/types/transform.h"
 
 namespace stcalib {
 
@@ -15,6 +16,10 @@ namespace stcalib {
 // 4-byte encapsulation header; primitives aligned to their size from the end of that header).
 // Only the messages and fields a calibration reads; every decoder checks every length against
 // the bytes it was given and names the message type in its errors.
+
+// The std_msgs/Header that opens a message (Image, CompressedImage, CameraInfo, PointCloud2, Imu,
+// Odometry), without reading the rest.
+Status DecodeHeader(const std::vector<uint8_t>& cdr, int64_t* stamp_ns, std::string* frame_id);
 
 struct RosImage {
   int64_t stamp_ns = 0;  ///< header.stamp [ns]
@@ -97,10 +102,34 @@ struct CloudPoints {
   std::vector<float> intensity;  ///< empty without an intensity field
   std::vector<uint16_t> ring;    ///< empty without a ring field
   std::vector<double> time_s;    ///< empty without a time field
+  std::vector<uint32_t> row;     ///< each point's row of an organized cloud (height > 1), else empty
   std::string time_field;        ///< which field gave the times
 };
 // Points with a non-finite coordinate (a dense=false cloud's no-returns) are left out. Errors
 // name a missing x, y or z field, a field past the point's end and an inconsistent size.
 Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* points);
+
+// tf2_msgs/msg/TFMessage: geometry_msgs/TransformStamped, each the pose of `child_frame_id` in
+// `frame_id` (a point's child coordinates map to parent ones: p_parent = T_parent_child · p_child).
+struct RosTransform {
+  int64_t stamp_ns = 0;
+  std::string frame_id;        ///< parent
+  std::string child_frame_id;  ///< child
+  Rigid3d T_parent_child = Rigid3d::Identity();
+};
+Status DecodeTfMessage(const std::vector<uint8_t>& cdr, std::vector<RosTransform>* transforms);
+
+// Encoders: little-endian CDR that the decoders above read back field for field (for `stcalib
+// convert`, which writes drives as bags). Covariances are written as zeros, CameraInfo's binning
+// and region of interest as "none".
+std::vector<uint8_t> EncodeImage(const RosImage& image);
+std::vector<uint8_t> EncodeCameraInfo(const RosCameraInfo& info);
+std::vector<uint8_t> EncodePointCloud2(const RosPointCloud& cloud);
+std::vector<uint8_t> EncodeOdometry(const RosOdometry& odometry);
+std::vector<uint8_t> EncodeTfMessage(const std::vector<RosTransform>& transforms);
+
+// The ros2msg text of a message type the encoders write, with its nested types (an MCAP schema);
+// empty for any other type.
+std::string Ros2MsgDefinition(const std::string& type);
 
 }  // namespace stcalib

@@ -10,10 +10,15 @@
 namespace stcalib {
 
 // One LiDAR sweep as stored in a KITTI velodyne .bin: float32 x, y, z, reflectance per point,
-// in the LiDAR frame, in scan order (docs/method.md §10).
+// in the LiDAR frame, in scan order (docs/method.md §10). A sweep from a ROS 2 bag may also carry
+// what its driver wrote per point: the ring (then the points are grouped by ring, each ring in
+// KITTI's azimuth order) and the capture time; KITTI's files carry neither, and the features
+// then split the rings and time the points from the azimuth.
 struct LidarScan {
   std::vector<Eigen::Vector3d> points_lidar;  ///< [m]
   std::vector<float> reflectance;             ///< [0, 1]
+  std::vector<uint16_t> ring;                 ///< empty, or one per point, non-decreasing
+  std::vector<double> point_time_s;           ///< empty, or capture time − sweep stamp [s]
 
   size_t size() const { return points_lidar.size(); }
 };

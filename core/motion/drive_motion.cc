@@ -10,6 +10,20 @@
 namespace stcalib {
 
 Status DriveMotion::Create(const Drive& drive, DriveMotion* motion) {
+  if (!drive.odometry.empty()) {
+    if (!drive.has_imu_calibration) {
+      return Status::Error(drive.drive_dir +
+                           ": the odometry's frame has no transform to the LiDAR's");
+    }
+    DriveMotion m;
+    STCALIB_RETURN_IF_ERROR(OxtsTrajectory::FromOdometry(drive.odometry, &m.trajectory_)
+                                .WithContext(drive.drive_dir + ": "));
+    m.T_imu_lidar_ = drive.T_lidar_imu.inverse();
+    m.source_ = Source::kOdometry;
+    m.reference_ns_ = m.trajectory_.reference_ns();
+    *motion = std::move(m);
+    return Status::Ok();
+  }
   if (!drive.has_oxts) {
     return Status::Error(drive.drive_dir + ": no oxts/ folder, so no vehicle motion");
   }
@@ -26,8 +40,22 @@ Status DriveMotion::Create(const Drive& drive, DriveMotion* motion) {
   return Status::Ok();
 }
 
+const char* DriveMotion::SourceName() const {
+  switch (source_) {
+    case Source::kOxts:
+      return "oxts";
+    case Source::kOdometry:
+      return "odometry";
+    case Source::kScanRegistration:
+      break;
+  }
+  return "scan_registration";
+}
+
 Status DriveMotion::CreateForDrive(const Drive& drive, DriveMotion* motion) {
-  if (drive.has_oxts && drive.has_imu_calibration) return Create(drive, motion);
+  if ((drive.has_oxts || !drive.odometry.empty()) && drive.has_imu_calibration) {
+    return Create(drive, motion);
+  }
   LOG(WARNING) << (drive.has_oxts ? drive.calib_dir +
                                         "/calib_imu_to_velo.txt: missing, so the "
                                         "oxts motion cannot be used"
@@ -52,7 +80,7 @@ Status DriveMotion::CreateFromScans(const Drive& drive, DriveMotion* motion) {
       const double r = p.norm();
       if (r > 2.0 && r < 60.0) points->push_back(p);
     }
-    if (points->size() < 1000) return Status::Error(drive.VelodynePath(k) + ": too few points");
+    if (points->size() < 1000) return Status::Error(drive.ScanName(k) + ": too few points");
     return Status::Ok();
   };
   std::vector<Eigen::Vector3d> previous, current;
@@ -107,7 +135,7 @@ Status DriveMotion::CreateFromScans(const Drive& drive, DriveMotion* motion) {
 }
 
 Rigid3d DriveMotion::T_world_lidar(double t_s) const {
-  if (source_ == Source::kOxts) return trajectory_.T_world_imu_s(t_s) * T_imu_lidar_;
+  if (measured()) return trajectory_.T_world_imu_s(t_s) * T_imu_lidar_;
   // Constant velocity on the segment around t (the first or last one outside the sweeps).
   const std::vector<double>& times = scan_times_s_;
   size_t i = std::upper_bound(times.begin(), times.end(), t_s) - times.begin();
@@ -118,7 +146,7 @@ Rigid3d DriveMotion::T_world_lidar(double t_s) const {
 }
 
 double DriveMotion::GapAround(double t_s) const {
-  if (source_ == Source::kOxts) return trajectory_.GapAround(t_s);
+  if (measured()) return trajectory_.GapAround(t_s);
   if (t_s < scan_times_s_.front()) return scan_times_s_.front() - t_s;
   if (t_s > scan_times_s_.back()) return t_s - scan_times_s_.back();
   return 0.0;

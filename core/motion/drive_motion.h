@@ -10,24 +10,29 @@
 namespace stcalib {
 
 // The LiDAR's motion over a drive. Two sources:
-// - oxts (Create): the oxts packets and calib_imu_to_velo.txt, interpolated between packets;
+// - oxts (Create): the oxts packets and calib_imu_to_velo.txt, interpolated between packets; a
+//   bag's odometry samples (Drive::odometry) the same way, with the transform from its tf;
 // - scan registration (CreateFromScans, for drives without oxts): each sweep registered to the
 //   previous one with NDT, and a constant velocity between consecutive sweep stamps (docs/method.md
 //   §3's constant-velocity model), extrapolated with the nearest segment's velocity.
 // Times are seconds relative to a reference stamp (the first oxts or LiDAR stamp).
 class DriveMotion {
  public:
-  enum class Source { kOxts, kScanRegistration };
+  enum class Source { kOxts, kOdometry, kScanRegistration };
 
-  // Fails with the reason when the drive has no usable oxts (no folder, bad stamps).
+  // Fails with the reason when the drive has no usable oxts or odometry (no folder, bad stamps).
   static Status Create(const Drive& drive, DriveMotion* motion);
   // Fails when fewer than two sweeps can be read and registered.
   static Status CreateFromScans(const Drive& drive, DriveMotion* motion);
-  // Create when the drive has oxts and calib_imu_to_velo.txt, else CreateFromScans with a
+  // Create when the drive has oxts or odometry and calib_imu_to_velo.txt, else CreateFromScans with a
   // warning that says why.
   static Status CreateForDrive(const Drive& drive, DriveMotion* motion);
 
   Source source() const { return source_; }
+  // The poses come from a measured trajectory (oxts or odometry) looked up at the stamps, not
+  // from the sweeps themselves.
+  bool measured() const { return source_ != Source::kScanRegistration; }
+  const char* SourceName() const;  ///< "oxts", "odometry" or "scan_registration" 
   Rigid3d T_world_lidar(double t_s) const;
   LidarPoseFunction PoseFunction() const;
   double Seconds(StampNs stamp_ns) const { return NsToSeconds(stamp_ns - reference_ns_); }

@@ -36,6 +36,27 @@ Status OxtsTrajectory::Create(const std::vector<OxtsPacket>& packets,
   return Status::Ok();
 }
 
+Status OxtsTrajectory::FromOdometry(const std::vector<OdometrySample>& samples,
+                                    OxtsTrajectory* trajectory) {
+  if (samples.empty()) return Status::Error("odometry: no messages");
+  OxtsTrajectory t;
+  t.reference_ns_ = samples.front().stamp_ns;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const double time_s = NsToSeconds(samples[i].stamp_ns - t.reference_ns_);
+    if (!t.times_s_.empty() && time_s <= t.times_s_.back()) {
+      LOG(WARNING) << "odometry: message " << i
+                   << " skipped: its stamp does not increase (duplicated or out of order)";
+      continue;
+    }
+    t.times_s_.push_back(time_s);
+    t.poses_.push_back(samples[i].T_world_body);
+    t.velocities_world_.push_back(samples[i].velocity_world_m_s);
+    t.rates_body_.push_back(samples[i].rate_body_rad_s);
+  }
+  *trajectory = std::move(t);
+  return Status::Ok();
+}
+
 double OxtsTrajectory::GapAround(double t) const {
   if (times_s_.empty()) return std::numeric_limits<double>::infinity();
   if (t <= times_s_.front()) return times_s_.front() - t;

@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include "core/io/drive.h"
 #include "core/io/oxts.h"
 #include "core/io/timestamps.h"
 #include "core/motion/oxts_poses.h"
@@ -20,6 +21,11 @@ class OxtsTrajectory {
   // warning; fewer than one usable packet is an error.
   static Status Create(const std::vector<OxtsPacket>& packets,
                        const std::vector<StampNs>& stamps_ns, OxtsTrajectory* trajectory);
+
+  // The same from odometry samples (a bag's nav_msgs/Odometry): their poses, world velocities
+  // and body rates stand for the packets'.
+  static Status FromOdometry(const std::vector<OdometrySample>& samples,
+                             OxtsTrajectory* trajectory);
 
   Rigid3d T_world_imu(StampNs stamp_ns) const;
   Rigid3d T_world_imu_s(double seconds_since_reference) const;

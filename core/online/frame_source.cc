@@ -105,7 +105,10 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   const double oxts_gap_s = motion_.GapAround(camera_s);
   if (oxts_gap_s > options_.max_oxts_gap_s) {
     const bool oxts = motion_.source() == DriveMotion::Source::kOxts;
-    return Status::Error(drive_->drive_dir + (oxts ? "/oxts" : "/velodyne_points") + ": frame " +
+    const bool odometry = motion_.source() == DriveMotion::Source::kOdometry;
+    return Status::Error(drive_->drive_dir +
+                         (oxts ? "/oxts" : odometry ? " (odometry)" : "/velodyne_points") +
+                         ": frame " +
                          std::to_string(frame) + " falls in a gap of " +
                          std::to_string(oxts_gap_s) + " s between motion measurements (more than " +
                          std::to_string(options_.max_oxts_gap_s) + " s): no motion model");
