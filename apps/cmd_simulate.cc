@@ -30,6 +30,11 @@ int RunSimulate() {
     return UsageError(
         "simulate", "--camera must be " + sim::SimCameraChoices() + ", got '" + FLAGS_camera + "'");
   }
+  if (!sim::ParseSimLidar(FLAGS_lidar, &options.lidar)) {
+    return UsageError("simulate",
+                      "--lidar must be " + sim::SimLidarChoices() + ", got '" + FLAGS_lidar + "'");
+  }
+  options.distortion_k1 = FLAGS_distortion_k1;
   const Status valid = options.Validate();
   if (!valid.ok()) return UsageError("simulate", valid.message());
 
@@ -44,11 +49,12 @@ int RunSimulate() {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf(
-      "simulated %d frames (scene %s, camera %s, seed %llu, time offset %+.4f s, %d moving "
-      "objects) in %.1f s\ndrive: %s\n",
+      "simulated %d frames (scene %s, camera %s, lidar %s, seed %llu, time offset %+.4f s, %d "
+      "moving objects) in %.1f s\ndrive: %s\n",
       options.frames, sim::SceneTypeName(options.scene).c_str(),
-      sim::SimCameraName(options.camera).c_str(), static_cast<unsigned long long>(options.seed),
-      options.time_offset_s, options.dynamic_objects, seconds, drive_dir.c_str());
+      sim::SimCameraName(options.camera).c_str(), sim::SimLidarName(options.lidar).c_str(),
+      static_cast<unsigned long long>(options.seed), options.time_offset_s, options.dynamic_objects,
+      seconds, drive_dir.c_str());
   return kExitOk;
 }
 

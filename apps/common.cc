@@ -20,16 +20,30 @@ int UsageError(const std::string& command, const std::string& message) {
   return kExitUsage;
 }
 
-Status ReadGroundTruth(const Drive& drive, bool* found, CalibrationState* truth) {
-  const std::string path = drive.calib_dir + "/ground_truth.json";
-  *found = std::filesystem::exists(path);
-  if (!*found) return Status::Ok();
+namespace {
+
+Status ReadJson(const std::string& path, nlohmann::json* json) {
   std::vector<std::string> lines;
   STCALIB_RETURN_IF_ERROR(ReadLines(path, &lines));
   std::string text;
   for (const auto& l : lines) text += l + "\n";
   try {
-    const nlohmann::json j = nlohmann::json::parse(text);
+    *json = nlohmann::json::parse(text);
+  } catch (const std::exception& e) {
+    return Status::Error(path + ": " + e.what());
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ReadGroundTruth(const Drive& drive, bool* found, CalibrationState* truth) {
+  const std::string path = drive.calib_dir + "/ground_truth.json";
+  *found = std::filesystem::exists(path);
+  if (!*found) return Status::Ok();
+  nlohmann::json j;
+  STCALIB_RETURN_IF_ERROR(ReadJson(path, &j));
+  try {
     const auto& m = j.at("T_camera_lidar");
     if (m.size() != 16) return Status::Error(path + ": T_camera_lidar must have 16 numbers");
     Eigen::Matrix4d T;
@@ -39,6 +53,16 @@ Status ReadGroundTruth(const Drive& drive, bool* found, CalibrationState* truth)
   } catch (const std::exception& e) {
     return Status::Error(path + ": " + e.what());
   }
+  return Status::Ok();
+}
+
+Status ReadSimulatedLidarName(const Drive& drive, std::string* lidar) {
+  lidar->clear();
+  const std::string path = drive.calib_dir + "/ground_truth.json";
+  if (!std::filesystem::exists(path)) return Status::Ok();
+  nlohmann::json j;
+  STCALIB_RETURN_IF_ERROR(ReadJson(path, &j));
+  if (j.contains("lidar") && j["lidar"].is_string()) *lidar = j["lidar"].get<std::string>();
   return Status::Ok();
 }
 

@@ -33,6 +33,12 @@ DEFINE_string(scene, "urban", "simulate: urban | poles (vertical structures only
 DEFINE_string(camera, "kitti",
               "simulate: kitti (1242x375) | kitti_1003 (1241x376) | hd720 (1280x720, 3 deg "
               "nose-down)");
+DEFINE_string(lidar, "hdl64",
+              "simulate: hdl64 (KITTI's Velodyne HDL-64E) | vlp16 (Velodyne VLP-16) | os1-64 "
+              "(Ouster OS1-64)");
+DEFINE_double(distortion_k1, 0.0,
+              "simulate: radial distortion k1 of raw camera images (plumb_bob; 0 = rectified "
+              "images, as KITTI's)");
 DEFINE_double(lidar_hz, 10.0, "simulate: LiDAR spin rate = frame rate of every sensor [Hz]");
 DEFINE_double(oxts_white_position_m, 0.001,
               "simulate: σ of each oxts packet's own position noise per axis, on top of the "

@@ -19,6 +19,8 @@ DECLARE_double(time_offset_s);
 DECLARE_int32(dynamic_objects);
 DECLARE_string(scene);
 DECLARE_string(camera);
+DECLARE_string(lidar);
+DECLARE_double(distortion_k1);
 DECLARE_double(lidar_hz);
 DECLARE_double(oxts_white_position_m);
 DECLARE_double(oxts_error_scale);

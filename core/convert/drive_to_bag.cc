@@ -22,35 +22,118 @@ constexpr char kLidarFrame[] = "lidar";
 constexpr char kImuFrame[] = "imu";
 constexpr char kWorldFrame[] = "world";
 
-// The cloud of one sweep: x, y, z, intensity (float32), ring (uint16), time (float64) per point.
-RosPointCloud MakeCloud(const LidarScan& scan, const std::vector<uint16_t>& ring,
-                        const std::vector<double>& time_s, int64_t stamp_ns) {
+void Put(uint8_t* p, const void* value, size_t n) { std::memcpy(p, value, n); }
+
+// One sweep's cloud in `layout`. `time_s` is each point's capture time from `stamp_ns` (the
+// drive's LiDAR stamp, mid-sweep for KITTI); the layouts that stamp the start move the stamp to
+// the sweep's first instant, `sweep_s` before its end, and their times with it.
+RosPointCloud MakeCloud(const LidarScan& scan, const ScanRings& rings,
+                        const std::vector<double>& time_s, int64_t stamp_ns, double sweep_s,
+                        CloudLayout layout) {
   RosPointCloud cloud;
-  cloud.stamp_ns = stamp_ns;
   cloud.frame_id = kLidarFrame;
-  cloud.height = 1;
-  cloud.width = static_cast<uint32_t>(scan.size());
-  cloud.fields = {{"x", 0, 7, 1},         {"y", 4, 7, 1},     {"z", 8, 7, 1},
-                  {"intensity", 12, 7, 1}, {"ring", 16, 4, 1}, {"time", 24, 8, 1}};
-  cloud.point_step = 32;
-  cloud.row_step = cloud.point_step * cloud.width;
-  cloud.dense = true;
-  cloud.data.assign(size_t{cloud.row_step}, 0);
-  for (size_t i = 0; i < scan.size(); ++i) {
-    uint8_t* p = cloud.data.data() + i * cloud.point_step;
-    const float xyzi[4] = {static_cast<float>(scan.points_lidar[i].x()),
-                           static_cast<float>(scan.points_lidar[i].y()),
-                           static_cast<float>(scan.points_lidar[i].z()),
-                           scan.reflectance.empty() ? 0.0f : scan.reflectance[i]};
-    std::memcpy(p, xyzi, sizeof(xyzi));
-    std::memcpy(p + 16, &ring[i], sizeof(uint16_t));
-    std::memcpy(p + 24, &time_s[i], sizeof(double));
+  cloud.stamp_ns = stamp_ns;
+  const size_t n = scan.size();
+  const int num_rings = rings.num_rings();
+  auto xyz = [&](size_t i, uint8_t* p) {
+    const float v[3] = {static_cast<float>(scan.points_lidar[i].x()),
+                        static_cast<float>(scan.points_lidar[i].y()),
+                        static_cast<float>(scan.points_lidar[i].z())};
+    Put(p, v, sizeof(v));
+  };
+  auto intensity = [&](size_t i) { return scan.reflectance.empty() ? 0.0f : scan.reflectance[i]; };
+  if (layout == CloudLayout::kKitti) {
+    cloud.height = 1;
+    cloud.width = static_cast<uint32_t>(n);
+    cloud.fields = {{"x", 0, 7, 1},          {"y", 4, 7, 1},     {"z", 8, 7, 1},
+                    {"intensity", 12, 7, 1}, {"ring", 16, 4, 1}, {"time", 24, 8, 1}};
+    cloud.point_step = 32;
+    cloud.data.assign(n * cloud.point_step, 0);
+    for (size_t i = 0; i < n; ++i) {
+      uint8_t* p = cloud.data.data() + i * cloud.point_step;
+      const float value = intensity(i);
+      xyz(i, p);
+      Put(p + 12, &value, 4);
+      Put(p + 16, &rings.ring[i], 2);
+      Put(p + 24, &time_s[i], 8);
+    }
+  } else {
+    // Stamped at the sweep's start: the first instant of the spin, half a sweep before the
+    // stamp, which the KITTI layout puts where the head faces forward.
+    const int64_t start_ns = stamp_ns - std::llround(0.5e9 * sweep_s);
+    const double shift_s = 1e-9 * static_cast<double>(stamp_ns - start_ns);
+    cloud.stamp_ns = start_ns;
+    std::vector<size_t> order(n);
+    for (size_t i = 0; i < n; ++i) order[i] = i;
+    if (layout == CloudLayout::kVelodyne) {
+      // Firing order: by capture time, the beams of one firing from the lowest up.
+      std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+        if (time_s[a] != time_s[b]) return time_s[a] < time_s[b];
+        return rings.elevation_rank[rings.ring[a]] > rings.elevation_rank[rings.ring[b]];
+      });
+      cloud.height = 1;
+      cloud.width = static_cast<uint32_t>(n);
+      cloud.fields = {{"x", 0, 7, 1},          {"y", 4, 7, 1},     {"z", 8, 7, 1},
+                      {"intensity", 12, 7, 1}, {"ring", 16, 4, 1}, {"time", 18, 7, 1}};
+      cloud.point_step = 22;
+      cloud.data.assign(n * cloud.point_step, 0);
+      for (size_t k = 0; k < n; ++k) {
+        const size_t i = order[k];
+        uint8_t* p = cloud.data.data() + k * cloud.point_step;
+        const float value = intensity(i);
+        const uint16_t ring =
+            static_cast<uint16_t>(num_rings - 1 - rings.elevation_rank[rings.ring[i]]);
+        const float time = static_cast<float>(time_s[i] + shift_s);
+        xyz(i, p);
+        Put(p + 12, &value, 4);
+        Put(p + 16, &ring, 2);
+        Put(p + 18, &time, 4);
+      }
+    } else {
+      // A row per beam (top first), a column per firing in spin order (clockwise: the azimuth
+      // falls from +π), as the sensor's fixed azimuth steps give them.
+      const int columns = rings.azimuth_step_rad > 0
+                              ? static_cast<int>(std::lround(2 * M_PI / rings.azimuth_step_rad))
+                              : 1024;
+      cloud.height = static_cast<uint32_t>(num_rings);
+      cloud.width = static_cast<uint32_t>(columns);
+      cloud.fields = {{"x", 0, 7, 1},          {"y", 4, 7, 1},        {"z", 8, 7, 1},
+                      {"intensity", 16, 7, 1}, {"t", 20, 6, 1},       {"reflectivity", 24, 4, 1},
+                      {"ring", 26, 4, 1},      {"ambient", 28, 4, 1}, {"range", 32, 6, 1}};
+      cloud.point_step = 48;
+      cloud.data.assign(size_t{cloud.height} * cloud.width * cloud.point_step, 0);
+      for (size_t i = 0; i < n; ++i) {
+        const int row = rings.elevation_rank[rings.ring[i]];
+        const double fraction = (M_PI - rings.azimuth_rad[i]) / (2 * M_PI);
+        const int column = std::clamp(static_cast<int>(fraction * columns), 0, columns - 1);
+        uint8_t* p =
+            cloud.data.data() + (static_cast<size_t>(row) * columns + column) * cloud.point_step;
+        uint32_t range_mm;
+        std::memcpy(&range_mm, p + 32, 4);
+        if (range_mm != 0) continue;  // a second return in one cell: the first stays
+        const float value = intensity(i) * 255.0f;
+        const uint32_t t_ns =
+            static_cast<uint32_t>(std::max<int64_t>(0, std::llround(1e9 * (time_s[i] + shift_s))));
+        const uint16_t reflectivity = static_cast<uint16_t>(value),
+                       ring = static_cast<uint16_t>(row);
+        range_mm = std::max<uint32_t>(1, static_cast<uint32_t>(1000 * scan.points_lidar[i].norm()));
+        xyz(i, p);
+        Put(p + 16, &value, 4);
+        Put(p + 20, &t_ns, 4);
+        Put(p + 24, &reflectivity, 2);
+        Put(p + 26, &ring, 2);
+        Put(p + 32, &range_mm, 4);
+      }
+    }
   }
+  cloud.row_step = cloud.point_step * cloud.width;
+  cloud.dense = layout != CloudLayout::kOuster;
   return cloud;
 }
 
 // The YAML rosbag2 writes beside its storage files (the fields `ros2 bag info` reads).
-std::string MetadataYaml(const std::string& mcap_name, const std::map<std::string, std::string>& types,
+std::string MetadataYaml(const std::string& mcap_name,
+                         const std::map<std::string, std::string>& types,
                          const std::map<std::string, uint64_t>& counts, uint64_t messages,
                          int64_t start_ns, int64_t end_ns) {
   std::string y = "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n";
@@ -75,7 +158,14 @@ std::string MetadataYaml(const std::string& mcap_name, const std::map<std::strin
 
 }  // namespace
 
-Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, DriveToBagSummary* summary) {
+CloudLayout CloudLayoutForLidar(const std::string& lidar_name) {
+  if (lidar_name == "vlp16") return CloudLayout::kVelodyne;
+  if (lidar_name == "os1-64") return CloudLayout::kOuster;
+  return CloudLayout::kKitti;
+}
+
+Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, CloudLayout layout,
+                       DriveToBagSummary* summary) {
   *summary = DriveToBagSummary();
   std::error_code ec;
   if (fs::exists(bag_dir, ec) && !fs::is_empty(bag_dir, ec)) {
@@ -134,12 +224,17 @@ Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, DriveToBa
   info.distortion_model = "plumb_bob";
   info.d.assign(5, 0.0);
   info.K = drive.camera.P_rect_02.leftCols<3>();
+  if (!drive.camera.distortion_model.empty()) {  // raw images: their model goes with them
+    info.distortion_model = drive.camera.distortion_model;
+    info.d = drive.camera.distortion;
+    info.K = drive.camera.K;
+  }
   info.R = drive.camera.R_rect_00;
   info.P = drive.camera.P_rect_02;
   const double sweep_s = SweepDurationSeconds(drive);
-  const OxtsOrigin origin = odometry ? OxtsOrigin{drive.oxts.front().lat, drive.oxts.front().lon,
-                                                  drive.oxts.front().alt}
-                                     : OxtsOrigin{};
+  const OxtsOrigin origin =
+      odometry ? OxtsOrigin{drive.oxts.front().lat, drive.oxts.front().lon, drive.oxts.front().alt}
+               : OxtsOrigin{};
   for (size_t i = 0; i < n; ++i) {
     if (odometry) {
       // As OxtsTrajectory reads a packet: its pose, its earth-parallel velocity in the world
@@ -160,7 +255,7 @@ Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, DriveToBa
       end_ns = std::max(end_ns, o.stamp_ns);
     }
     cv::Mat bgr;
-    STCALIB_RETURN_IF_ERROR(drive.LoadImage(i, &bgr));
+    STCALIB_RETURN_IF_ERROR(drive.LoadRawImage(i, &bgr));
     RosImage image;
     image.stamp_ns = drive.camera_stamps_ns[i];
     image.frame_id = kCameraFrame;
@@ -179,11 +274,11 @@ Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, DriveToBa
     STCALIB_RETURN_IF_ERROR(drive.LoadScan(i, &scan));
     const ScanRings rings = scan.ring.empty() ? SplitIntoRings(scan.points_lidar)
                                               : RingsFromLabels(scan.points_lidar, scan.ring);
-    const std::vector<double> times = scan.point_time_s.empty()
-                                          ? PointTimesFromAzimuth(rings, sweep_s)
-                                          : scan.point_time_s;
-    write(kBagCloudTopic, drive.lidar_stamps_ns[i],
-          EncodePointCloud2(MakeCloud(scan, rings.ring, times, drive.lidar_stamps_ns[i])));
+    const std::vector<double> times =
+        scan.point_time_s.empty() ? PointTimesFromAzimuth(rings, sweep_s) : scan.point_time_s;
+    const RosPointCloud cloud =
+        MakeCloud(scan, rings, times, drive.lidar_stamps_ns[i], sweep_s, layout);
+    write(kBagCloudTopic, cloud.stamp_ns, EncodePointCloud2(cloud));
     end_ns = std::max({end_ns, drive.camera_stamps_ns[i], drive.lidar_stamps_ns[i]});
   }
   STCALIB_RETURN_IF_ERROR(writer.Close());

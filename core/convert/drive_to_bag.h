@@ -12,10 +12,10 @@ namespace stcalib {
 // through the bag path. Topics and frames:
 // - kBagImageTopic: sensor_msgs/msg/Image, bgr8, frame "camera", stamped with the image;
 // - kBagCameraInfoTopic: sensor_msgs/msg/CameraInfo beside every image (R = R_rect_00,
-//   P = P_rect_02, K = P's left 3 × 3, no distortion: KITTI's images are rectified);
-// - kBagCloudTopic: sensor_msgs/msg/PointCloud2, frame "lidar", fields x, y, z, intensity
-//   (float32), ring (uint16) and time (float64 seconds from the stamp), the rings and capture
-//   times stcalib derives from a KITTI sweep (which stores neither), in its point order;
+//   P = P_rect_02, K = P's left 3 × 3, no distortion: KITTI's images are rectified; a simulated
+//   raw camera's images go as they are, with its model, K and D);
+// - kBagCloudTopic: sensor_msgs/msg/PointCloud2, frame "lidar", in a driver's CloudLayout, with
+//   the rings and capture times stcalib derives from a KITTI sweep (which stores neither);
 // - kBagOdometryTopic: nav_msgs/msg/Odometry from the oxts packets, "world" to "imu": the pose
 //   KITTI's devkit builds, the twist in the body frame (only with oxts and calib_imu_to_velo.txt);
 // - /tf_static: "camera" ← "lidar" (the drive's calib_velo_to_cam.txt) and "lidar" ← "imu".
@@ -25,6 +25,19 @@ inline constexpr char kBagCameraInfoTopic[] = "/camera/camera_info";
 inline constexpr char kBagCloudTopic[] = "/lidar/points";
 inline constexpr char kBagOdometryTopic[] = "/odom";
 
+// How the clouds are laid out, as a driver writes them (all carry the same points and times):
+enum class CloudLayout {
+  kKitti,     ///< KITTI's point order, stamped mid-sweep; x y z intensity, ring, time (float64 s)
+  kVelodyne,  ///< velodyne_pointcloud's: firing order, stamped at the sweep's start; x y z
+              ///< intensity (float32), ring (uint16, 0 = lowest beam), time (float32 s)
+  kOuster,    ///< ouster-ros's: organized (a row per beam, top first; a column per firing in
+              ///< spin order; no return = zeros), stamped at the start; t (uint32 ns), ring
+              ///< (uint16, 0 = top), reflectivity, ambient, range
+};
+// The layout of a simulated drive's LiDAR (ground_truth.json's "lidar": vlp16 → Velodyne's,
+// os1-64 → Ouster's), else KITTI's.
+CloudLayout CloudLayoutForLidar(const std::string& lidar_name);
+
 struct DriveToBagSummary {
   size_t frames = 0;
   uint64_t messages = 0;
@@ -33,6 +46,7 @@ struct DriveToBagSummary {
 };
 
 // `bag_dir` must not exist yet or be empty; errors name the drive's file or the bag's.
-Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, DriveToBagSummary* summary);
+Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, CloudLayout layout,
+                       DriveToBagSummary* summary);
 
 }  // namespace stcalib

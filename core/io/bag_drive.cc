@@ -33,7 +33,8 @@ constexpr char kTfType[] = "tf2_msgs/msg/TFMessage";
 struct Spooled {
   uint64_t offset = 0, size = 0;
   int64_t stamp_ns = 0;
-  size_t index = 0;  ///< its place among the topic's messages
+  int64_t middle_ns = 0;  ///< a sweep's middle (its points' times), else the stamp
+  size_t index = 0;       ///< its place among the topic's messages
 };
 
 std::string StampText(int64_t stamp_ns) {
@@ -75,7 +76,6 @@ class BagFrameStore : public FrameStore {
                            std::to_string(image_bgr->rows) + " pixels, but the CameraInfo says " +
                            std::to_string(width) + " × " + std::to_string(height));
     }
-    RectifyImage(maps, image_bgr);
     return Status::Ok();
   }
 
@@ -98,7 +98,6 @@ class BagFrameStore : public FrameStore {
   }
 
   std::vector<Spooled> images, clouds;  ///< per frame
-  RectifyMaps maps;
   int width = 0, height = 0;
 
  private:
@@ -125,8 +124,8 @@ std::string SpoolPath() {
   std::error_code ec;
   fs::path dir = fs::temp_directory_path(ec);
   if (ec) dir = ".";
-  return (dir / ("stcalib-bag-" + std::to_string(getpid()) + "-" + std::to_string(counter++) +
-                 ".spool"))
+  return (dir /
+          ("stcalib-bag-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + ".spool"))
       .string();
 }
 
@@ -279,6 +278,7 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
     Spooled s;
     const Status status = DecodeHeader(m.data, &s.stamp_ns, frame);
     if (!status.ok()) return fail(m, status);
+    s.middle_ns = s.stamp_ns;
     s.offset = spooled_bytes;
     s.size = m.data.size();
     s.index = list->size();
@@ -305,6 +305,18 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
             return fail(m, Status::Error(std::string("not a ") + kCloudType));
           }
           spool_message(m, &clouds, &cloud_frame);
+          if (!failure.ok()) return;
+          // The sweep's middle, from its points' times: drivers stamp the start or the end.
+          RosPointCloud cloud;
+          CloudPoints points;
+          Status status = DecodePointCloud2(m.data, &cloud);
+          if (status.ok()) status = ExtractCloudPoints(cloud, &points);
+          if (!status.ok()) return fail(m, status);
+          if (!points.time_s.empty()) {
+            const auto [first, last] =
+                std::minmax_element(points.time_s.begin(), points.time_s.end());
+            clouds.back().middle_ns += std::llround(0.5e9 * (*first + *last));
+          }
         } else if (topic == info_topic && !have_info) {
           if (type != kInfoType) return fail(m, Status::Error(std::string("not a ") + kInfoType));
           const Status status = DecodeCameraInfo(m.data, &info);
@@ -338,8 +350,8 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
   if (!summary.stopped.empty()) {
     LOG(WARNING) << bag << ": " << summary.stopped << "; calibrating with what came before";
   }
-  for (const std::string& topic : {options.image_topic, options.cloud_topic, info_topic,
-                                   options.odom_topic}) {
+  for (const std::string& topic :
+       {options.image_topic, options.cloud_topic, info_topic, options.odom_topic}) {
     if (!topic.empty() && !summary.topics.count(topic)) {
       return cleanup(Status::Error(bag + ": no topic " + topic + " (" +
                                    (topic == info_topic && options.camera_info_topic.empty()
@@ -351,19 +363,19 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
   }
   if (!have_info) return cleanup(Status::Error(bag + ": " + info_topic + " has no message"));
   if (clouds.empty() || images.empty()) {
-    return cleanup(Status::Error(bag + ": " + (clouds.empty() ? options.cloud_topic
-                                                               : options.image_topic) +
+    return cleanup(Status::Error(bag + ": " +
+                                 (clouds.empty() ? options.cloud_topic : options.image_topic) +
                                  " has no message"));
   }
 
-  // Frames: each sweep with the image nearest its stamp, within half the sweep period; an image
+  // Frames: each sweep with the image nearest its middle, within half the sweep period; an image
   // serves the sweep nearest to it only.
-  auto by_stamp = [](const Spooled& a, const Spooled& b) { return a.stamp_ns < b.stamp_ns; };
+  auto by_stamp = [](const Spooled& a, const Spooled& b) { return a.middle_ns < b.middle_ns; };
   std::stable_sort(images.begin(), images.end(), by_stamp);
   std::stable_sort(clouds.begin(), clouds.end(), by_stamp);
   std::vector<int64_t> periods;
   for (size_t k = 1; k < clouds.size(); ++k) {
-    periods.push_back(clouds[k].stamp_ns - clouds[k - 1].stamp_ns);
+    periods.push_back(clouds[k].middle_ns - clouds[k - 1].middle_ns);
   }
   int64_t period_ns = 100000000;
   if (!periods.empty()) {
@@ -375,7 +387,7 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
     const auto it = std::lower_bound(images.begin(), images.end(), clouds[c], by_stamp);
     for (auto candidate : {it, it == images.begin() ? images.end() : std::prev(it)}) {
       if (candidate == images.end()) continue;
-      const int64_t gap = std::llabs(candidate->stamp_ns - clouds[c].stamp_ns);
+      const int64_t gap = std::llabs(candidate->middle_ns - clouds[c].middle_ns);
       const size_t i = static_cast<size_t>(candidate - images.begin());
       if (2 * gap > period_ns) continue;
       auto found = best.find(i);
@@ -384,9 +396,8 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
   }
   std::map<size_t, size_t> frames;  // cloud → image (by cloud: time order)
   for (const auto& [image, pair] : best) {
-    if (!frames.count(pair.second) ||
-        std::llabs(images[frames[pair.second]].stamp_ns - clouds[pair.second].stamp_ns) >
-            pair.first) {
+    if (!frames.count(pair.second) || std::llabs(images[frames[pair.second]].middle_ns -
+                                                 clouds[pair.second].middle_ns) > pair.first) {
       frames[pair.second] = image;
     }
   }
@@ -396,10 +407,9 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
                                  options.cloud_topic));
   }
 
-  auto store = std::make_shared<BagFrameStore>(bag, spool_path, options.image_topic,
-                                               options.cloud_topic,
-                                               summary.topics.at(options.image_topic).type ==
-                                                   kCompressedType);
+  auto store = std::make_shared<BagFrameStore>(
+      bag, spool_path, options.image_topic, options.cloud_topic,
+      summary.topics.at(options.image_topic).type == kCompressedType);
   drive->drive_dir = bag;
   drive->calib_dir = bag;
   for (const auto& [cloud, image] : frames) {
@@ -413,7 +423,7 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
   }
   STCALIB_RETURN_IF_ERROR(
       CameraFromInfo(info, &drive->camera).WithContext(bag + ": " + info_topic + ": "));
-  STCALIB_RETURN_IF_ERROR(MakeRectifyMaps(drive->camera, &store->maps));
+  STCALIB_RETURN_IF_ERROR(MakeRectifyMaps(drive->camera, &drive->rectify));
   store->width = drive->camera.image_width;
   store->height = drive->camera.image_height;
 

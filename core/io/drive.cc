@@ -83,10 +83,16 @@ Status Drive::CheckFrame(size_t frame) const {
   return Status::Ok();
 }
 
-Status Drive::LoadImage(size_t frame, cv::Mat* image_bgr) const {
+Status Drive::LoadRawImage(size_t frame, cv::Mat* image_bgr) const {
   STCALIB_RETURN_IF_ERROR(CheckFrame(frame));
   if (store) return store->LoadImage(frame, image_bgr);
   return ReadImage(ImagePath(frame), image_bgr);
+}
+
+Status Drive::LoadImage(size_t frame, cv::Mat* image_bgr) const {
+  STCALIB_RETURN_IF_ERROR(LoadRawImage(frame, image_bgr));
+  RectifyImage(rectify, image_bgr);
+  return Status::Ok();
 }
 
 Status Drive::LoadScan(size_t frame, LidarScan* scan) const {
@@ -142,7 +148,10 @@ Status OpenDrive(const std::string& drive_dir_in, const std::string& calib_dir_i
     VLOG(1) << oxts_dir << ": no oxts folder";
   }
 
-  STCALIB_RETURN_IF_ERROR(ReadCamToCam(drive->calib_dir + "/calib_cam_to_cam.txt", &drive->camera));
+  const std::string cam_to_cam = drive->calib_dir + "/calib_cam_to_cam.txt";
+  STCALIB_RETURN_IF_ERROR(ReadCamToCam(cam_to_cam, &drive->camera));
+  STCALIB_RETURN_IF_ERROR(
+      MakeRectifyMaps(drive->camera, &drive->rectify).WithContext(cam_to_cam + ": "));
   STCALIB_RETURN_IF_ERROR(
       ReadVeloToCam(drive->calib_dir + "/calib_velo_to_cam.txt", &drive->T_camera_lidar));
   const std::string imu_path = drive->calib_dir + "/calib_imu_to_velo.txt";

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/io/image.h"
 #include "core/io/kitti_calib.h"
 #include "core/io/oxts.h"
 #include "core/io/timestamps.h"
@@ -19,7 +20,7 @@ namespace stcalib {
 class FrameStore {
  public:
   virtual ~FrameStore() = default;
-  virtual Status LoadImage(size_t frame, cv::Mat* image_bgr) const = 0;
+  virtual Status LoadImage(size_t frame, cv::Mat* image_bgr) const = 0;  ///< as stored (raw)
   virtual Status LoadScan(size_t frame, LidarScan* scan) const = 0;
   virtual std::string ScanName(size_t frame) const = 0;  ///< names the sweep in messages
 };
@@ -43,6 +44,7 @@ struct Drive {
   std::vector<std::string> frame_names;  ///< e.g. "0000000000"
 
   CameraCalibration camera;
+  RectifyMaps rectify;  ///< raw image_02 to rectified (camera.distortion_model set), else empty
   Rigid3d T_camera_lidar = Rigid3d::Identity();  ///< from calib_velo_to_cam.txt
   bool has_imu_calibration = false;              ///< calib_imu_to_velo.txt read (oxts need it)
   Rigid3d T_lidar_imu = Rigid3d::Identity();     ///< from calib_imu_to_velo.txt
@@ -66,7 +68,8 @@ struct Drive {
   std::string VelodynePath(size_t frame) const;
   std::string LabelsPath(size_t frame) const;  ///< simulated drives only
   std::string ScanName(size_t frame) const;    ///< the .bin path, or the store's name for it
-  Status LoadImage(size_t frame, cv::Mat* image_bgr) const;
+  Status LoadImage(size_t frame, cv::Mat* image_bgr) const;     ///< rectified
+  Status LoadRawImage(size_t frame, cv::Mat* image_bgr) const;  ///< as stored
   Status LoadScan(size_t frame, LidarScan* scan) const;
   // Checks `frame` against the number of frames; the error names the drive.
   Status CheckFrame(size_t frame) const;

@@ -15,7 +15,9 @@ std::string Trim(const std::string& s) {
   return s.substr(begin, end - begin + 1);
 }
 
-bool IsTextKey(const std::string& key) { return key == "calib_time"; }
+bool IsTextKey(const std::string& key) {
+  return key == "calib_time" || key == "distortion_model_02";
+}
 
 std::string FormatNumber(double value) {
   char buffer[40];
@@ -183,6 +185,18 @@ Status ReadCamToCam(const std::string& path, CameraCalibration* calibration) {
   calibration->image_height = static_cast<int>(height);
   if (P_rect(0, 0) <= 0 || P_rect(1, 1) <= 0 || P_rect(2, 2) <= 0) {
     return Status::Error(path + ": key 'P_rect_02' has non-positive focal lengths");
+  }
+  // stcalib's key for raw image_02 images (a simulated distorted camera): KITTI's own files carry
+  // K_02 and D_02 too, but their image_02 is rectified, and they have no such key.
+  const std::string model = file.Text("distortion_model_02");
+  if (!model.empty()) {
+    Eigen::MatrixXd K;
+    STCALIB_RETURN_IF_ERROR(file.GetMatrix("K_02", 3, 3, &K));
+    if (!file.Has("D_02"))
+      return Status::Error(path + ": key 'D_02' missing (distortion_model_02)");
+    calibration->distortion_model = model;
+    calibration->K = K;
+    calibration->distortion = file.numbers().at("D_02");
   }
   return Status::Ok();
 }

@@ -357,7 +357,7 @@ Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* out) {
       for (int a = 0; a < 3; ++a) {
         point[a] = FieldValue(p + xyz[a]->offset, xyz[a]->datatype, cloud.big_endian);
       }
-      if (!point.allFinite()) continue;
+      if (!point.allFinite() || point.isZero()) continue;  // no return (NaN, or Ouster's zeros)
       out->points.push_back(point);
       if (cloud.height > 1) out->row.push_back(r);
       if (intensity) {
@@ -464,9 +464,9 @@ std::vector<uint8_t> EncodeCameraInfo(const RosCameraInfo& m) {
   for (int k = 0; k < 9; ++k) out.Put(m.K(k / 3, k % 3));
   for (int k = 0; k < 9; ++k) out.Put(m.R(k / 3, k % 3));
   for (int k = 0; k < 12; ++k) out.Put(m.P(k / 4, k % 4));
-  out.Put(uint32_t{0}).Put(uint32_t{0});                    // binning
-  for (int k = 0; k < 4; ++k) out.Put(uint32_t{0});         // roi
-  out.Put(uint8_t{0});                                      // roi.do_rectify
+  out.Put(uint32_t{0}).Put(uint32_t{0});             // binning
+  for (int k = 0; k < 4; ++k) out.Put(uint32_t{0});  // roi
+  out.Put(uint8_t{0});                               // roi.do_rectify
   return out.Take();
 }
 
@@ -474,7 +474,8 @@ std::vector<uint8_t> EncodePointCloud2(const RosPointCloud& m) {
   CdrWriter out;
   out.Header(m.stamp_ns, m.frame_id).Put(m.height).Put(m.width);
   out.Put(static_cast<uint32_t>(m.fields.size()));
-  for (const RosPointField& f : m.fields) out.String(f.name).Put(f.offset).Put(f.datatype).Put(f.count);
+  for (const RosPointField& f : m.fields)
+    out.String(f.name).Put(f.offset).Put(f.datatype).Put(f.count);
   out.Put(static_cast<uint8_t>(m.big_endian)).Put(m.point_step).Put(m.row_step).Bytes(m.data);
   out.Put(static_cast<uint8_t>(m.dense));
   return out.Take();
@@ -502,8 +503,9 @@ std::vector<uint8_t> EncodeTfMessage(const std::vector<RosTransform>& transforms
 std::string Ros2MsgDefinition(const std::string& type) {
   const std::string separator =
       "\n================================================================================\nMSG: ";
-  const std::string header = separator + "std_msgs/Header\nbuiltin_interfaces/Time stamp\n"
-                                         "string frame_id" +
+  const std::string header = separator +
+                             "std_msgs/Header\nbuiltin_interfaces/Time stamp\n"
+                             "string frame_id" +
                              separator + "builtin_interfaces/Time\nint32 sec\nuint32 nanosec";
   const std::string vector3 = separator + "geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z";
   const std::string quaternion = separator +

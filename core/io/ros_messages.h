@@ -102,10 +102,11 @@ struct CloudPoints {
   std::vector<float> intensity;  ///< empty without an intensity field
   std::vector<uint16_t> ring;    ///< empty without a ring field
   std::vector<double> time_s;    ///< empty without a time field
-  std::vector<uint32_t> row;     ///< each point's row of an organized cloud (height > 1), else empty
-  std::string time_field;        ///< which field gave the times
+  std::vector<uint32_t> row;  ///< each point's row of an organized cloud (height > 1), else empty
+  std::string time_field;     ///< which field gave the times
 };
-// Points with a non-finite coordinate (a dense=false cloud's no-returns) are left out. Errors
+// Points with a non-finite coordinate (a dense=false cloud's no-returns) or at the origin (an
+// organized Ouster cloud's) are left out. Errors
 // name a missing x, y or z field, a field past the point's end and an inconsistent size.
 Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* points);
 

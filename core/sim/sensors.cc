@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 
 namespace stcalib::sim {
 namespace {
@@ -40,12 +42,36 @@ double TextureGain(const Material& m, const Eigen::Vector3d& p) {
 }  // namespace
 
 double LidarModel::ElevationDeg(int beam) const {
+  if (!beam_elevations_deg.empty()) return beam_elevations_deg.at(beam);
   const int half = beams / 2;
   if (beam < half) {
     return elevation_top_deg + (elevation_upper_bottom_deg - elevation_top_deg) * beam / (half - 1);
   }
   return elevation_lower_top_deg +
          (elevation_bottom_deg - elevation_lower_top_deg) * (beam - half) / (beams - half - 1);
+}
+
+LidarModel MakeLidarModel(SimLidar lidar) {
+  LidarModel model;
+  switch (lidar) {
+    case SimLidar::kHdl64:
+      break;
+    case SimLidar::kVlp16:
+      for (int k = 0; k < 16; ++k) model.beam_elevations_deg.push_back(15.0 - 2.0 * k);
+      model.azimuth_step_deg = 0.2;
+      model.max_range_m = 100.0;
+      model.range_noise_m = 0.03;
+      break;
+    case SimLidar::kOs1_64:
+      for (int k = 0; k < 64; ++k) model.beam_elevations_deg.push_back(16.6 - 33.2 * k / 63);
+      model.azimuth_step_deg = 360.0 / 1024;
+      model.range_noise_m = 0.03;
+      break;
+  }
+  if (!model.beam_elevations_deg.empty()) {
+    model.beams = static_cast<int>(model.beam_elevations_deg.size());
+  }
+  return model;
 }
 
 SimulatedSweep SimulateLidarSweep(const Scene& scene, const SimTrajectory& trajectory,
@@ -143,14 +169,45 @@ cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, c
     const double k = std::clamp(dir.z() * 3.0, 0.0, 1.0);
     return Eigen::Vector3d((1 - k) * sky_horizon + k * sky_top);
   };
-  // First pass: one ray through each pixel centre.
   const int w = rig.width, h = rig.height;
+  // A distorted camera: each raw pixel's ray is the rectified pixel it undistorts to (OpenCV's
+  // undistortPoints at the pixel centres; between them, for the edge pixels' sub-samples,
+  // interpolated bilinearly: the map is smooth).
+  std::vector<cv::Point2d> centres;
+  if (!rig.distortion.empty()) {
+    cv::Mat K_cv, R_cv;
+    cv::eigen2cv(K, K_cv);
+    cv::eigen2cv(rig.R_rect_00, R_cv);
+    const cv::Mat D_cv = cv::Mat(rig.distortion, true).reshape(1, 1);
+    std::vector<cv::Point2d> raw;
+    raw.reserve(static_cast<size_t>(w) * h);
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) raw.emplace_back(u, v);
+    }
+    cv::undistortPoints(raw, centres, K_cv, D_cv, R_cv, K_cv);
+  }
+  auto rectified = [&](double u, double v) {
+    if (centres.empty()) return cv::Point2d(u, v);
+    const double uc = std::clamp(u, 0.0, w - 1.0), vc = std::clamp(v, 0.0, h - 1.0);
+    const int u0 = std::min(static_cast<int>(uc), w - 2),
+              v0 = std::min(static_cast<int>(vc), h - 2);
+    const double a = uc - u0, b = vc - v0;
+    auto at = [&](int uu, int vv) { return centres[static_cast<size_t>(vv) * w + uu]; };
+    const cv::Point2d q = (1 - a) * (1 - b) * at(u0, v0) + a * (1 - b) * at(u0 + 1, v0) +
+                          (1 - a) * b * at(u0, v0 + 1) + a * b * at(u0 + 1, v0 + 1);
+    return q + cv::Point2d(u - uc, v - vc);  // beyond the border, the border's offset
+  };
+  auto shade_raw = [&](double u, double v, int* surface, int* material) {
+    const cv::Point2d q = rectified(u, v);
+    return shade(q.x, q.y, surface, material);
+  };
+  // First pass: one ray through each pixel centre.
   std::vector<Eigen::Vector3d> radiance(static_cast<size_t>(w) * h);
   std::vector<int> surface(radiance.size()), material(radiance.size());
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const size_t i = static_cast<size_t>(v) * w + u;
-      radiance[i] = shade(u, v, &surface[i], &material[i]);
+      radiance[i] = shade_raw(u, v, &surface[i], &material[i]);
     }
   }
   // Second pass: a pixel whose neighbours see another surface or material straddles an edge; it
@@ -173,8 +230,8 @@ cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, c
       int unused_surface, unused_material;
       for (int a = 0; a < kSub; ++a) {
         for (int b = 0; b < kSub; ++b) {
-          sum += shade(u + (a + 0.5) / kSub - 0.5, v + (b + 0.5) / kSub - 0.5, &unused_surface,
-                       &unused_material);
+          sum += shade_raw(u + (a + 0.5) / kSub - 0.5, v + (b + 0.5) / kSub - 0.5, &unused_surface,
+                           &unused_material);
         }
       }
       radiance[i] = sum / (kSub * kSub);

@@ -15,9 +15,11 @@
 
 namespace stcalib::sim {
 
-// An HDL-64E-like spinning LiDAR: 64 beams (32 from +2° to −8.33°, 32 from −8.83° to −24.9°),
-// spinning clockwise seen from above, one return per beam and azimuth step.
+// An HDL-64E-like spinning LiDAR by default: 64 beams (32 from +2° to −8.33°, 32 from −8.83° to
+// −24.9°), spinning clockwise seen from above, one return per beam and azimuth step. Other
+// sensors (MakeLidarModel) list their beams' elevations instead.
 struct LidarModel {
+  std::vector<double> beam_elevations_deg;  ///< top beam first; empty: the HDL-64E's two blocks
   double elevation_top_deg = 2.0;
   double elevation_upper_bottom_deg = -8.33;
   double elevation_lower_top_deg = -8.83;
@@ -31,6 +33,15 @@ struct LidarModel {
 
   double ElevationDeg(int beam) const;  ///< beam 0 is the top one
 };
+
+// The simulated LiDARs (`simulate --lidar`): beams, azimuth step, range and noise as the data
+// sheets give them.
+enum class SimLidar {
+  kHdl64,   ///< Velodyne HDL-64E (KITTI's): 64 beams +2° to −24.9°, 0.09° steps at 10 Hz
+  kVlp16,   ///< Velodyne VLP-16: 16 beams ±15° every 2°, 0.2° steps at 10 Hz, 100 m, σ 3 cm
+  kOs1_64,  ///< Ouster OS1-64 (gen 1): 64 beams ±16.6°, 1024 columns, 120 m, σ 3 cm
+};
+LidarModel MakeLidarModel(SimLidar lidar);
 
 struct SimulatedSweep {
   LidarScan scan;                    ///< KITTI order: lasers top to bottom, each CCW from ahead
@@ -54,9 +65,14 @@ struct CameraRig {
   Rigid3d T_imu_camera = Rigid3d::Identity();  ///< unrectified camera 0 in the IMU frame
   Eigen::Vector3d sun_world = Eigen::Vector3d(0.3, 0.4, 0.87).normalized();
   double noise_sigma = 2.0;  ///< image noise σ [grey levels]
+  // A raw, distorted image instead of a rectified one: plumb_bob coefficients k1 k2 p1 p2 k3 of a
+  // camera with matrix P_rect_02's left 3 × 3 whose frame is the unrectified one R_rect_00 turns
+  // (ROS CameraInfo's model: rectified pixel = P · R · X). Empty: rectified.
+  std::vector<double> distortion;
 };
 
-// Renders image_02 at time t_s (global shutter) by ray casting through P_rect_02 and R_rect_00.
+// Renders image_02 at time t_s (global shutter) by ray casting through P_rect_02 and R_rect_00,
+// each pixel's ray first undistorted when the rig has a distortion.
 cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, const CameraRig& rig,
                           double t_s, std::mt19937_64* rng);
 

@@ -101,7 +101,16 @@ constexpr EnumNames<SimCamera, 3> kCameraNames = {{{SimCamera::kKitti, "kitti"},
                                                    {SimCamera::kKitti1003, "kitti_1003"},
                                                    {SimCamera::kHd720, "hd720"}}};
 
+constexpr EnumNames<SimLidar, 3> kLidarNames = {
+    {{SimLidar::kHdl64, "hdl64"}, {SimLidar::kVlp16, "vlp16"}, {SimLidar::kOs1_64, "os1-64"}}};
+
 }  // namespace
+
+bool ParseSimLidar(const std::string& name, SimLidar* lidar) {
+  return ParseEnumName(kLidarNames, name, lidar);
+}
+std::string SimLidarName(SimLidar lidar) { return EnumName(kLidarNames, lidar); }
+std::string SimLidarChoices() { return EnumNameChoices(kLidarNames); }
 
 bool ParseSimCamera(const std::string& name, SimCamera* camera) {
   return ParseEnumName(kCameraNames, name, camera);
@@ -157,6 +166,9 @@ Status SimulatorOptions::Validate() const {
     return Status::Error("--dynamic_objects must be between 0 and 200, got " +
                          std::to_string(dynamic_objects));
   }
+  if (!(std::abs(distortion_k1) <= 1.0)) {
+    return Status::Error("--distortion_k1 must be within ±1, got " + std::to_string(distortion_k1));
+  }
   if (!(std::abs(camera_delay_s) < 0.5 / lidar_hz)) {
     return Status::Error("camera delay must be under half a frame period");
   }
@@ -197,6 +209,8 @@ Simulator::Simulator(const SimulatorOptions& options) : options_(options) {
   std::uniform_real_distribution<double> angle(-0.5, 0.5), offset(-0.02, 0.02);
   const Eigen::Vector3d rpy_deg(angle(calib_rng), angle(calib_rng), angle(calib_rng));
   rig_ = MakeCameraRig(options.camera);
+  if (options.distortion_k1 != 0.0) rig_.distortion = {options.distortion_k1, 0.0, 0.0, 0.0, 0.0};
+  lidar_ = MakeLidarModel(options.lidar);
   // The rig's nose-down tilt about the camera centre (which stays at KITTI's mount): a point
   // straight ahead moves up the image (camera y is down).
   T_camera_lidar_ = MakeRigid(ExpSO3(Eigen::Vector3d(rig_.nose_down_deg * M_PI / 180.0, 0, 0)),
@@ -239,6 +253,11 @@ KittiCalibFile Simulator::CameraCalibFile() const {
   file.SetNumbers("S_rect_02", {static_cast<double>(rig_.width), static_cast<double>(rig_.height)});
   file.SetMatrix("R_rect_02", Eigen::Matrix3d::Identity());
   file.SetMatrix("P_rect_02", rig_.P_rect_02);
+  if (!rig_.distortion.empty()) {
+    file.SetText("distortion_model_02", "plumb_bob");
+    file.SetMatrix("K_02", rig_.P_rect_02.leftCols<3>());
+    file.SetNumbers("D_02", rig_.distortion);
+  }
   return file;
 }
 
@@ -376,6 +395,8 @@ Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& o
         {"seed", options.seed},
         {"scene", SceneTypeName(options.scene)},
         {"camera", SimCameraName(options.camera)},
+        {"lidar", SimLidarName(options.lidar)},
+        {"distortion_k1", options.distortion_k1},
         {"frames", options.frames},
         {"lidar_hz", options.lidar_hz},
         {"dynamic_objects", options.dynamic_objects},

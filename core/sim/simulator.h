@@ -30,6 +30,9 @@ std::string SimCameraName(SimCamera camera);
 std::string SimCameraChoices();  ///< "kitti, kitti_1003 or hd720"
 // Intrinsics, rectification and size of `camera` (pose, sun and noise keep their defaults).
 CameraRig MakeCameraRig(SimCamera camera);
+bool ParseSimLidar(const std::string& name, SimLidar* lidar);
+std::string SimLidarName(SimLidar lidar);
+std::string SimLidarChoices();  ///< "hdl64, vlp16 or os1-64"
 
 struct SimulatorOptions {
   int frames = 40;             ///< frames to simulate (camera, LiDAR and oxts each)
@@ -40,6 +43,10 @@ struct SimulatorOptions {
   double lidar_hz = 10.0;          ///< spin rate = frame rate of every sensor [Hz]
   double camera_delay_s = 0.0105;  ///< camera exposure after the LiDAR faces forward [s]
   SimCamera camera = SimCamera::kKitti;
+  SimLidar lidar = SimLidar::kHdl64;
+  // Radial distortion k1 of a raw camera image (0: rectified images, as KITTI's); the drive's
+  // calib_cam_to_cam.txt then says so (distortion_model_02, K_02, D_02).
+  double distortion_k1 = 0.0;
   NavigationErrorOptions oxts_error;  ///< the oxts packets' drift and noise
 
   Status Validate() const;
