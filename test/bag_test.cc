@@ -275,6 +275,48 @@ TEST(Mcap, ReadsAFile) {
   ExpectTheThreeMessages(read);
 }
 
+// McapWriter's files read back record by record, and cut short they say where they stop.
+TEST(Mcap, WritesWhatItReads) {
+  testing::ScopedTempDir tmp;
+  const std::string path = tmp.path() + "/out_0.mcap";
+  {
+    McapWriter writer;
+    ASSERT_TRUE(writer.Open(path).ok());
+    const uint16_t points =
+        writer.AddChannel(writer.AddSchema("sensor_msgs/msg/PointCloud2", "x"), "/points");
+    const uint16_t image =
+        writer.AddChannel(writer.AddSchema("sensor_msgs/msg/Image", "y"), "/image");
+    writer.Write(points, 10, {1, 2, 3});
+    writer.Write(image, 11, std::vector<uint8_t>(70000, 7));  // larger than any read buffer
+    writer.Write(points, 12, {4});
+    ASSERT_TRUE(writer.Close().ok());
+    EXPECT_EQ(writer.messages_written(), 3u);
+  }
+  Read read;
+  auto visit = [&](const McapChannel& channel, const McapMessage& message) {
+    read.topics.push_back(channel.topic + " " + channel.schema_name + " " +
+                          channel.message_encoding);
+    read.messages.push_back(message);
+  };
+  read.status = ReadMcap(path, visit, &read.summary);
+  ASSERT_TRUE(read.status.ok()) << read.status.message();
+  EXPECT_EQ(read.summary.profile, "ros2");
+  EXPECT_TRUE(read.summary.stopped.empty()) << read.summary.stopped;
+  ASSERT_EQ(read.messages.size(), 3u);
+  EXPECT_EQ(read.topics[0], "/points sensor_msgs/msg/PointCloud2 cdr");
+  EXPECT_EQ(read.topics[1], "/image sensor_msgs/msg/Image cdr");
+  EXPECT_EQ(read.messages[1].data.size(), 70000u);
+  EXPECT_EQ(read.messages[2].sequence, 1u);  // counted per channel
+  EXPECT_EQ(read.messages[2].log_time_ns, 12u);
+
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 60);
+  read = Read();
+  read.status = ReadMcap(path, visit, &read.summary);
+  ASSERT_TRUE(read.status.ok());
+  EXPECT_EQ(read.messages.size(), 2u);
+  EXPECT_THAT(read.summary.stopped, HasSubstr("truncated"));
+}
+
 // The fuzzers' seed bag (written by a separate script from the specification): an Image outside
 // chunks and a PointCloud2 inside one, both decoded.
 TEST(Mcap, ReadsTheSeedBagAndDecodesItsMessages) {

@@ -385,21 +385,34 @@ Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* out) {
 }
 
 Status DecodeTfMessage(const std::vector<uint8_t>& cdr, std::vector<RosTransform>* transforms) {
-  return Decode(cdr, "tf2_msgs/msg/TFMessage", transforms,
-                [&](Cdr* in, std::vector<RosTransform>* m) {
-                  const uint32_t n = in->Get<uint32_t>();
-                  if (n > cdr.size() / 64) return in->Fail();  // each takes more than 64 bytes
-                  for (uint32_t k = 0; in->ok() && k < n; ++k) {
-                    RosTransform t;
-                    in->Header(&t.stamp_ns, &t.frame_id);
-                    t.child_frame_id = in->String();
-                    const Eigen::Vector3d translation = GetVector3(in);
-                    const Eigen::Quaterniond rotation = GetQuaternion(in);
-                    t.T_parent_child.linear() = rotation.normalized().toRotationMatrix();
-                    t.T_parent_child.translation() = translation;
-                    m->push_back(t);
-                  }
-                });
+  std::vector<Eigen::Quaterniond> rotations;
+  STCALIB_RETURN_IF_ERROR(
+      Decode(cdr, "tf2_msgs/msg/TFMessage", transforms, [&](Cdr* in, std::vector<RosTransform>* m) {
+        const uint32_t n = in->Get<uint32_t>();
+        if (n > cdr.size() / 64) return in->Fail();  // each takes more than 64 bytes
+        for (uint32_t k = 0; in->ok() && k < n; ++k) {
+          RosTransform t;
+          in->Header(&t.stamp_ns, &t.frame_id);
+          t.child_frame_id = in->String();
+          const Eigen::Vector3d translation = GetVector3(in);
+          const Eigen::Quaterniond rotation = GetQuaternion(in);
+          rotations.push_back(rotation);
+          t.T_parent_child.translation() = translation;
+          m->push_back(t);
+        }
+      }));
+  // A transform a calibration would start from must be one: finite, with a unit quaternion.
+  for (size_t k = 0; k < transforms->size(); ++k) {
+    RosTransform& t = (*transforms)[k];
+    const double norm = rotations[k].norm();
+    if (!t.T_parent_child.translation().allFinite() || !(std::abs(norm - 1.0) < 1e-3)) {
+      return Status::Error("tf2_msgs/msg/TFMessage: transform " + t.frame_id + " <- " +
+                           t.child_frame_id + " is not a rigid transform (quaternion norm " +
+                           std::to_string(norm) + ")");
+    }
+    t.T_parent_child.linear() = rotations[k].normalized().toRotationMatrix();
+  }
+  return Status::Ok();
 }
 
 namespace {

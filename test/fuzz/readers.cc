@@ -80,6 +80,15 @@ void CheckCdr(const std::string& reader, const std::string& path, const std::vec
   ExpectTypeNamed(reader, path, DecodeImu(cdr, &imu), "sensor_msgs/msg/Imu");
   RosOdometry odometry;
   ExpectTypeNamed(reader, path, DecodeOdometry(cdr, &odometry), "nav_msgs/msg/Odometry");
+  std::vector<RosTransform> transforms;
+  status = DecodeTfMessage(cdr, &transforms);
+  ExpectTypeNamed(reader, path, status, "tf2_msgs/msg/TFMessage");
+  for (const RosTransform& t : transforms) {
+    if (!t.T_parent_child.matrix().allFinite() ||
+        !(t.T_parent_child.linear().determinant() > 0.999)) {
+      Broken(reader, path, "a transform that is not rigid accepted");
+    }
+  }
   RosPointCloud cloud;
   status = DecodePointCloud2(cdr, &cloud);
   ExpectTypeNamed(reader, path, status, "sensor_msgs/msg/PointCloud2");
