@@ -102,6 +102,7 @@ CalibrateJob CalibrateJobFromFlags() {
   job.bag.cloud_topic = FLAGS_cloud_topic;
   job.bag.camera_info_topic = FLAGS_camera_info_topic;
   job.bag.odom_topic = FLAGS_odom_topic;
+  job.bag.imu_topic = FLAGS_imu_topic;
   job.bag.require_tf_extrinsic = FLAGS_init_calib.empty();
   job.out_dir = FLAGS_out;
   job.perturb_rot_deg = FLAGS_perturb_rot_deg;
@@ -200,9 +201,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     outcome->reference = "ground truth (simulated)";
   } else {
     outcome->reference_state.T_camera_lidar = drive.T_camera_lidar;
-    outcome->reference = drive.store ? "drive calibration (" + drive.drive_dir + ": /tf_static)"
-                                     : "drive calibration (" + drive.calib_dir +
-                                           "/calib_velo_to_cam.txt)";
+    outcome->reference = drive.store
+                             ? "drive calibration (" + drive.drive_dir + ": /tf_static)"
+                             : "drive calibration (" + drive.calib_dir + "/calib_velo_to_cam.txt)";
   }
   CalibrationState initial;
   std::mt19937_64 rng(job.seed);

@@ -1,5 +1,6 @@
 // stcalib convert: a drive written as a ROS 2 bag (docs/method.md §9).
 #include <cstdio>
+#include <string>
 
 #include "apps/commands.h"
 #include "apps/flags.h"
@@ -20,13 +21,17 @@ int RunConvert() {
   DriveToBagSummary summary;
   status = WriteDriveAsBag(drive, FLAGS_bag, CloudLayoutForLidar(lidar), &summary);
   if (!status.ok()) return ReportError(kCommand, status);
+  std::string topics =
+      std::string(kBagImageTopic) + ", " + kBagCameraInfoTopic + ", " + kBagCloudTopic +
+      (summary.odometry ? std::string(", ") + kBagOdometryTopic + ", " + kBagImuTopic
+                        : std::string()) +
+      ", /tf_static";
   std::printf(
-      "wrote %s: %zu frames, %llu messages (%s, %s, %s%s%s, /tf_static)\n"
-      "calibrate it with: stcalib calibrate --bag=%s --image_topic=%s --cloud_topic=%s%s%s\n",
+      "wrote %s: %zu frames, %llu messages (%s)\n"
+      "calibrate it with: stcalib calibrate --bag=%s --image_topic=%s --cloud_topic=%s%s\n",
       summary.mcap_path.c_str(), summary.frames, static_cast<unsigned long long>(summary.messages),
-      kBagImageTopic, kBagCameraInfoTopic, kBagCloudTopic, summary.odometry ? ", " : "",
-      summary.odometry ? kBagOdometryTopic : "", FLAGS_bag.c_str(), kBagImageTopic, kBagCloudTopic,
-      summary.odometry ? " --odom_topic=" : "", summary.odometry ? kBagOdometryTopic : "");
+      topics.c_str(), FLAGS_bag.c_str(), kBagImageTopic, kBagCloudTopic,
+      summary.odometry ? (std::string(" --odom_topic=") + kBagOdometryTopic).c_str() : "");
   return kExitOk;
 }
 

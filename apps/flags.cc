@@ -20,6 +20,9 @@ DEFINE_string(camera_info_topic, "",
 DEFINE_string(odom_topic, "",
               "calibrate --bag: nav_msgs/msg/Odometry topic for the motion (default: none, the "
               "sweeps are registered)");
+DEFINE_string(imu_topic, "",
+              "calibrate --bag: sensor_msgs/msg/Imu topic whose rates shape the rotation between "
+              "registered sweeps (without --odom_topic)");
 DEFINE_int32(frame, 0, "frame index (0-based, in file-name order)");
 DEFINE_string(out, "",
               "output file or folder (calibrate, eval-temporal: optional; without it nothing "

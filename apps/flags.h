@@ -11,6 +11,7 @@ DECLARE_string(image_topic);
 DECLARE_string(cloud_topic);
 DECLARE_string(camera_info_topic);
 DECLARE_string(odom_topic);
+DECLARE_string(imu_topic);
 DECLARE_int32(frame);
 DECLARE_string(out);
 DECLARE_int32(frames);

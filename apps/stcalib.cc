@@ -52,7 +52,8 @@ const std::vector<Subcommand>& Subcommands() {
        {"drive", "frame", "out", "calib_dir", "detector"}},
       {"calibrate",
        "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T "
-       "[--camera_info_topic=T] [--odom_topic=T]) [--init_calib=FILE] [--perturb_rot_deg=D] "
+       "[--camera_info_topic=T] [--odom_topic=T | --imu_topic=T]) [--init_calib=FILE] "
+       "[--perturb_rot_deg=D] "
        "[--perturb_trans_m=M] [--perturb_time_s=S] [--init_uncertainty=DEG,M,S] [--seed=S] "
        "[--first_frame=I] [--num_frames=N] [--out=DIR] [--flagfile=configs/X.flags]",
        "online calibration of rotation, translation and time offset; with --out writes the "

@@ -104,6 +104,53 @@ TEST(BagDrive, KittiThroughTheBagIsTheSameDrive) {
   }
 }
 
+// Without odometry the sweeps are registered; the IMU's rates then shape the rotation between
+// them. Against the oxts trajectory, the LiDAR's rotation over 50 ms inside each segment (as the
+// de-skew and the motion model read it) is closer to it with the IMU than with a constant
+// velocity.
+TEST(BagDrive, ImuRatesShapeTheRotationBetweenRegisteredSweeps) {
+  STCALIB_REQUIRE_KITTI();
+  Drive kitti;
+  DriveMotion oxts;
+  ASSERT_TRUE(testing::OpenKittiDrive(&kitti, &oxts));
+  ScopedTempDir tmp;
+  const std::string bag_dir = tmp.path() + "/bag";
+  DriveToBagSummary summary;
+  ASSERT_TRUE(WriteDriveAsBag(kitti, bag_dir, CloudLayout::kKitti, &summary).ok());
+  BagDriveOptions options = ConvertedBagOptions(bag_dir, false);
+  Drive plain, with_imu;
+  ASSERT_TRUE(OpenBagDrive(options, &plain).ok());
+  options.imu_topic = kBagImuTopic;
+  ASSERT_TRUE(OpenBagDrive(options, &with_imu).ok());
+  ASSERT_EQ(with_imu.imu.size(), kitti.NumFrames());
+  options.odom_topic = kBagOdometryTopic;
+  EXPECT_THAT(OpenBagDrive(options, &plain).message(), ::testing::HasSubstr("not both"));
+  options.odom_topic.clear();
+  options.imu_topic.clear();
+  ASSERT_TRUE(OpenBagDrive(options, &plain).ok());
+
+  DriveMotion scans, scans_imu;
+  ASSERT_TRUE(DriveMotion::CreateForDrive(plain, &scans).ok());
+  ASSERT_TRUE(DriveMotion::CreateForDrive(with_imu, &scans_imu).ok());
+  EXPECT_STREQ(scans.SourceName(), "scan_registration");
+  EXPECT_STREQ(scans_imu.SourceName(), "scan_registration_imu");
+  double plain_sum = 0, imu_sum = 0;
+  for (size_t i = 0; i + 1 < kitti.NumFrames(); ++i) {
+    const StampNs a = kitti.lidar_stamps_ns[i] + 25000000, b = a + 50000000;
+    auto rotation = [&](const DriveMotion& m) {
+      const Rigid3d T_a = m.T_world_lidar(m.Seconds(a)), T_b = m.T_world_lidar(m.Seconds(b));
+      return Eigen::Matrix3d(T_a.linear().transpose() * T_b.linear());
+    };
+    const Eigen::Matrix3d truth = rotation(oxts);
+    plain_sum += LogSO3(truth.transpose() * rotation(scans)).norm();
+    imu_sum += LogSO3(truth.transpose() * rotation(scans_imu)).norm();
+  }
+  const double n = static_cast<double>(kitti.NumFrames() - 1);
+  LOG(INFO) << "mean rotation error over 50 ms: constant velocity " << plain_sum / n * 180 / M_PI
+            << " deg, IMU " << imu_sum / n * 180 / M_PI << " deg";
+  EXPECT_LT(imu_sum, plain_sum);
+}
+
 // A short simulated drive with a sparse LiDAR and a distorted camera, converted in each driver's
 // layout: every layout carries the drive's points, each at its own capture time, grouped by ring
 // in KITTI's order, and the raw images with the model that rectifies them as the drive does.

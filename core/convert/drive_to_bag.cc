@@ -196,6 +196,7 @@ Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, CloudLayo
   channel(kBagCameraInfoTopic, "sensor_msgs/msg/CameraInfo");
   channel(kBagCloudTopic, "sensor_msgs/msg/PointCloud2");
   if (odometry) channel(kBagOdometryTopic, "nav_msgs/msg/Odometry");
+  if (odometry) channel(kBagImuTopic, "sensor_msgs/msg/Imu");
 
   const size_t n = drive.NumFrames();
   if (n == 0) return Status::Error(drive.drive_dir + ": no frames to convert");
@@ -252,6 +253,13 @@ Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, CloudLayo
       o.linear_m_s = T_world_imu.linear().transpose() * velocity_world;
       o.angular_rad_s = Eigen::Vector3d(p.wx, p.wy, p.wz);
       write(kBagOdometryTopic, o.stamp_ns, EncodeOdometry(o));
+      RosImu imu;
+      imu.stamp_ns = o.stamp_ns;
+      imu.frame_id = kImuFrame;
+      imu.orientation = o.orientation;
+      imu.angular_velocity_rad_s = o.angular_rad_s;
+      imu.linear_acceleration_m_s2 = Eigen::Vector3d(p.ax, p.ay, p.az);
+      write(kBagImuTopic, imu.stamp_ns, EncodeImu(imu));
       end_ns = std::max(end_ns, o.stamp_ns);
     }
     cv::Mat bgr;

@@ -18,12 +18,15 @@ namespace stcalib {
 //   the rings and capture times stcalib derives from a KITTI sweep (which stores neither);
 // - kBagOdometryTopic: nav_msgs/msg/Odometry from the oxts packets, "world" to "imu": the pose
 //   KITTI's devkit builds, the twist in the body frame (only with oxts and calib_imu_to_velo.txt);
+// - kBagImuTopic: sensor_msgs/msg/Imu from the same packets, frame "imu": attitude, body rates
+//   and accelerations;
 // - /tf_static: "camera" ← "lidar" (the drive's calib_velo_to_cam.txt) and "lidar" ← "imu".
 // A simulated drive's ground_truth.json is copied beside metadata.yaml.
 inline constexpr char kBagImageTopic[] = "/camera/image_raw";
 inline constexpr char kBagCameraInfoTopic[] = "/camera/camera_info";
 inline constexpr char kBagCloudTopic[] = "/lidar/points";
 inline constexpr char kBagOdometryTopic[] = "/odom";
+inline constexpr char kBagImuTopic[] = "/imu";
 
 // How the clouds are laid out, as a driver writes them (all carry the same points and times):
 enum class CloudLayout {

@@ -28,6 +28,7 @@ constexpr char kCloudType[] = "sensor_msgs/msg/PointCloud2";
 constexpr char kInfoType[] = "sensor_msgs/msg/CameraInfo";
 constexpr char kOdometryType[] = "nav_msgs/msg/Odometry";
 constexpr char kTfType[] = "tf2_msgs/msg/TFMessage";
+constexpr char kImuType[] = "sensor_msgs/msg/Imu";
 
 // A message copied to the spool file.
 struct Spooled {
@@ -267,6 +268,7 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
   std::string image_frame, cloud_frame;
   std::vector<RosTransform> transforms;
   std::vector<RosOdometry> odometry;
+  std::vector<RosImu> imus;
   Status failure = Status::Ok();
   uint64_t spooled_bytes = 0;
   auto fail = [&](const BagMessage& m, const Status& status) {
@@ -330,6 +332,12 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
           const Status status = DecodeOdometry(m.data, &o);
           if (!status.ok()) return fail(m, status);
           odometry.push_back(o);
+        } else if (!options.imu_topic.empty() && topic == options.imu_topic) {
+          if (type != kImuType) return fail(m, Status::Error(std::string("not a ") + kImuType));
+          RosImu imu;
+          const Status status = DecodeImu(m.data, &imu);
+          if (!status.ok()) return fail(m, status);
+          imus.push_back(imu);
         } else if (type == kTfType && (topic == "/tf_static" || topic == "/tf")) {
           std::vector<RosTransform> t;
           const Status status = DecodeTfMessage(m.data, &t);
@@ -350,8 +358,11 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
   if (!summary.stopped.empty()) {
     LOG(WARNING) << bag << ": " << summary.stopped << "; calibrating with what came before";
   }
-  for (const std::string& topic :
-       {options.image_topic, options.cloud_topic, info_topic, options.odom_topic}) {
+  if (!options.imu_topic.empty() && !options.odom_topic.empty()) {
+    return cleanup(Status::Error(bag + ": give --odom_topic or --imu_topic, not both"));
+  }
+  for (const std::string& topic : {options.image_topic, options.cloud_topic, info_topic,
+                                   options.odom_topic, options.imu_topic}) {
     if (!topic.empty() && !summary.topics.count(topic)) {
       return cleanup(Status::Error(bag + ": no topic " + topic + " (" +
                                    (topic == info_topic && options.camera_info_topic.empty()
@@ -451,6 +462,25 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
       s.rate_body_rad_s = o.angular_rad_s;
       drive->odometry.push_back(s);
     }
+  }
+  if (!imus.empty()) {
+    const std::string imu_frame = imus.front().frame_id;
+    if (!LookUpTransform(transforms, cloud_frame, imu_frame, &drive->T_lidar_imu)) {
+      return Status::Error(bag + ": " + options.imu_topic + ": no transform between its frame \"" +
+                           imu_frame + "\" and the LiDAR frame \"" + cloud_frame +
+                           "\" in /tf_static or /tf");
+    }
+    drive->has_imu_calibration = true;
+    for (const RosImu& imu : imus) {
+      if (!imu.angular_velocity_rad_s.allFinite()) {
+        return Status::Error(bag + ": " + options.imu_topic + " message at " +
+                             StampText(imu.stamp_ns) + ": angular velocity is not finite");
+      }
+      drive->imu.push_back({imu.stamp_ns, imu.angular_velocity_rad_s});
+    }
+    std::stable_sort(
+        drive->imu.begin(), drive->imu.end(),
+        [](const ImuSample& a, const ImuSample& b) { return a.stamp_ns < b.stamp_ns; });
   }
   drive->store = std::move(store);
   LOG(INFO) << bag << ": " << drive->NumFrames() << " frames from " << clouds.size()

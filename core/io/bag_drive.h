@@ -12,7 +12,8 @@ namespace stcalib {
 // the cloud topic, paired with the image nearest its stamp (within half the sweep period); the
 // camera from the first CameraInfo; the extrinsic start and the odometry's transform to the LiDAR
 // from the bag's /tf_static (and /tf) chain between the messages' frame ids; the motion from the
-// odometry when a topic is given, else from scan registration. The images and sweeps stay on disk
+// odometry when a topic is given, else from scan registration (its rotation between sweeps
+// shaped by the IMU's rates when an IMU topic is given). The images and sweeps stay on disk
 // in a spool file beside nothing the user owns (the system's temporary folder) until the drive is
 // closed, so a long bag costs its index, not its size, in memory.
 struct BagDriveOptions {
@@ -21,6 +22,7 @@ struct BagDriveOptions {
   std::string cloud_topic;        ///< sensor_msgs/msg/PointCloud2
   std::string camera_info_topic;  ///< empty: the image topic's namespace + "/camera_info"
   std::string odom_topic;         ///< nav_msgs/msg/Odometry; empty: scan registration
+  std::string imu_topic;  ///< sensor_msgs/msg/Imu, with scan registration (not with odom_topic)
   // Without a tf between the camera and the LiDAR the start must come from elsewhere
   // (--init_calib); when this is set its absence is an error naming both frames.
   bool require_tf_extrinsic = true;

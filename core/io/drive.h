@@ -34,6 +34,12 @@ struct OdometrySample {
   Eigen::Vector3d rate_body_rad_s = Eigen::Vector3d::Zero();
 };
 
+// One IMU sample: its angular rates in the IMU frame.
+struct ImuSample {
+  StampNs stamp_ns = 0;
+  Eigen::Vector3d rate_rad_s = Eigen::Vector3d::Zero();
+};
+
 // A KITTI raw synced drive: image_02/, velodyne_points/ and (optionally) oxts/, each with data/
 // and timestamps.txt, plus the three calibration files in `calib_dir` (by default the drive's
 // parent folder). Frame i is the i-th file of image_02/data in name order; every sensor must
@@ -60,6 +66,9 @@ struct Drive {
 
   // A bag's odometry instead of oxts (the body is the frame T_lidar_imu places, "imu" above).
   std::vector<OdometrySample> odometry;
+  // A bag's IMU: angular rates in its frame (T_lidar_imu places it), which shape the rotation
+  // between registered sweeps (DriveMotion::CreateFromScans).
+  std::vector<ImuSample> imu;
   // Set for a drive read from a bag: its images and sweeps come from there, not from files.
   std::shared_ptr<const FrameStore> store;
 

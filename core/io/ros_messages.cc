@@ -502,6 +502,13 @@ std::vector<uint8_t> EncodeOdometry(const RosOdometry& m) {
   return out.Take();
 }
 
+std::vector<uint8_t> EncodeImu(const RosImu& m) {
+  CdrWriter out;
+  out.Header(m.stamp_ns, m.frame_id).Quaternion(m.orientation).Zeros(9);
+  out.Vector3(m.angular_velocity_rad_s).Zeros(9).Vector3(m.linear_acceleration_m_s2).Zeros(9);
+  return out.Take();
+}
+
 std::vector<uint8_t> EncodeTfMessage(const std::vector<RosTransform>& transforms) {
   CdrWriter out;
   out.Put(static_cast<uint32_t>(transforms.size()));
@@ -559,6 +566,13 @@ std::string Ros2MsgDefinition(const std::string& type) {
            separator +
            "geometry_msgs/Twist\ngeometry_msgs/Vector3 linear\ngeometry_msgs/Vector3 angular" +
            vector3;
+  }
+  if (type == "sensor_msgs/msg/Imu") {
+    return "std_msgs/Header header\ngeometry_msgs/Quaternion orientation\n"
+           "float64[9] orientation_covariance\ngeometry_msgs/Vector3 angular_velocity\n"
+           "float64[9] angular_velocity_covariance\ngeometry_msgs/Vector3 linear_acceleration\n"
+           "float64[9] linear_acceleration_covariance" +
+           header + quaternion + vector3;
   }
   if (type == "tf2_msgs/msg/TFMessage") {
     return "geometry_msgs/TransformStamped[] transforms" + separator +

@@ -127,6 +127,7 @@ std::vector<uint8_t> EncodeImage(const RosImage& image);
 std::vector<uint8_t> EncodeCameraInfo(const RosCameraInfo& info);
 std::vector<uint8_t> EncodePointCloud2(const RosPointCloud& cloud);
 std::vector<uint8_t> EncodeOdometry(const RosOdometry& odometry);
+std::vector<uint8_t> EncodeImu(const RosImu& imu);
 std::vector<uint8_t> EncodeTfMessage(const std::vector<RosTransform>& transforms);
 
 // The ros2msg text of a message type the encoders write, with its nested types (an MCAP schema);

@@ -49,7 +49,7 @@ const char* DriveMotion::SourceName() const {
     case Source::kScanRegistration:
       break;
   }
-  return "scan_registration";
+  return gyro_times_s_.empty() ? "scan_registration" : "scan_registration_imu";
 }
 
 Status DriveMotion::CreateForDrive(const Drive& drive, DriveMotion* motion) {
@@ -71,6 +71,23 @@ Status DriveMotion::CreateFromScans(const Drive& drive, DriveMotion* motion) {
   DriveMotion m;
   m.source_ = Source::kScanRegistration;
   m.reference_ns_ = drive.lidar_stamps_ns.front();
+  if (!drive.imu.empty() && drive.has_imu_calibration) {
+    m.R_lidar_imu_ = drive.T_lidar_imu.linear();
+    for (size_t k = 0; k < drive.imu.size(); ++k) {
+      const double t = NsToSeconds(drive.imu[k].stamp_ns - m.reference_ns_);
+      if (!m.gyro_times_s_.empty() && !(t > m.gyro_times_s_.back())) continue;  // repeated stamp
+      if (m.gyro_times_s_.empty()) {
+        m.gyro_rotations_.push_back(Eigen::Matrix3d::Identity());
+      } else {
+        // The mean of the two samples' rates over the interval (trapezoidal).
+        m.gyro_rates_.back() = 0.5 * (m.gyro_rates_.back() + drive.imu[k].rate_rad_s);
+        m.gyro_rotations_.push_back(m.gyro_rotations_.back() *
+                                    ExpSO3(m.gyro_rates_.back() * (t - m.gyro_times_s_.back())));
+      }
+      m.gyro_times_s_.push_back(t);
+      m.gyro_rates_.push_back(drive.imu[k].rate_rad_s);
+    }
+  }
   // Points between 2 and 60 m: the near car body and the sparse far field only add noise.
   auto load = [&](size_t k, std::vector<Eigen::Vector3d>* points) -> Status {
     LidarScan scan;
@@ -104,10 +121,11 @@ Status DriveMotion::CreateFromScans(const Drive& drive, DriveMotion* motion) {
       const double dt = t - m.scan_times_s_.back();
       // Constant-velocity guess from the last segment, scaled to this gap.
       const LidarTwist guess_twist = ConstantVelocityTwist(T_previous_current_guess, last_dt);
+      Rigid3d guess = LidarMotion(guess_twist, dt);
+      if (!m.gyro_times_s_.empty()) guess.linear() = m.GyroLidarRotation(t - dt, t);
       RegistrationResult result;
-      const Status registered =
-          RegisterNdt(current, previous, LidarMotion(guess_twist, dt), NdtOptions(), &result);
-      Rigid3d T_previous_current = LidarMotion(guess_twist, dt);
+      const Status registered = RegisterNdt(current, previous, guess, NdtOptions(), &result);
+      Rigid3d T_previous_current = guess;
       const bool plausible = registered.ok() && result.T_target_source.matrix().allFinite() &&
                              result.T_target_source.translation().norm() < 60.0 * dt + 0.5;
       if (plausible) {
@@ -142,7 +160,28 @@ Rigid3d DriveMotion::T_world_lidar(double t_s) const {
   i = std::min(std::max<size_t>(i, 1), times.size() - 1) - 1;
   const double dt = times[i + 1] - times[i];
   const LidarTwist twist = ConstantVelocityTwist(scan_poses_[i].inverse() * scan_poses_[i + 1], dt);
-  return scan_poses_[i] * LidarMotion(twist, t_s - times[i]);
+  Rigid3d T = scan_poses_[i] * LidarMotion(twist, t_s - times[i]);
+  if (gyro_times_s_.empty()) return T;
+  // The gyro's rotation since the segment's start, bent evenly by what it misses at the end.
+  const Eigen::Matrix3d registered =
+      scan_poses_[i].linear().transpose() * scan_poses_[i + 1].linear();
+  const Eigen::Vector3d miss =
+      LogSO3(GyroLidarRotation(times[i], times[i + 1]).transpose() * registered);
+  T.linear() = scan_poses_[i].linear() * GyroLidarRotation(times[i], t_s) *
+               ExpSO3(miss * ((t_s - times[i]) / dt));
+  return T;
+}
+
+Eigen::Matrix3d DriveMotion::GyroRotation(double t) const {
+  const std::vector<double>& times = gyro_times_s_;
+  size_t k = std::upper_bound(times.begin(), times.end(), t) - times.begin();
+  k = k == 0 ? 0 : k - 1;  // before the first sample: extrapolated with its rate
+  return gyro_rotations_[k] * ExpSO3(gyro_rates_[k] * (t - times[k]));
+}
+
+Eigen::Matrix3d DriveMotion::GyroLidarRotation(double a_s, double b_s) const {
+  return R_lidar_imu_ * GyroRotation(a_s).transpose() * GyroRotation(b_s) *
+         R_lidar_imu_.transpose();
 }
 
 double DriveMotion::GapAround(double t_s) const {
