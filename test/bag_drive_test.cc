@@ -364,6 +364,51 @@ TEST(BagDrive, BadBagsAreNamed) {
   EXPECT_THAT(status.message(), ::testing::HasSubstr("/points has no message"));
 }
 
+// A cloud without ring and time fields: in a driver's firing order its rings come from the
+// elevations (each the simulated beam's returns, in KITTI's order); in KITTI's order (as
+// kitti2bag writes KITTI's sweeps) it keeps that order for KITTI's ring split.
+TEST(BagDrive, RingsOfACloudWithoutThemComeFromItsOrderOrItsElevations) {
+  sim::SimulatorOptions options;
+  options.frames = 1;
+  options.lidar = sim::SimLidar::kVlp16;
+  const sim::Simulator simulator(options);
+  const sim::SimulatedSweep sweep = simulator.SimulateSweep(0);
+  CloudPoints kitti_order;
+  kitti_order.points = sweep.scan.points_lidar;
+  const LidarScan kept = ScanFromCloud(kitti_order, 1);
+  EXPECT_TRUE(kept.ring.empty());
+  EXPECT_EQ(kept.points_lidar, sweep.scan.points_lidar);
+
+  // Firing order: by capture time, then beam.
+  std::vector<size_t> firing(sweep.scan.size());
+  for (size_t i = 0; i < firing.size(); ++i) firing[i] = i;
+  std::stable_sort(firing.begin(), firing.end(), [&](size_t a, size_t b) {
+    return sweep.point_time_s[a] < sweep.point_time_s[b];
+  });
+  CloudPoints fired;
+  std::map<std::array<float, 3>, uint16_t> beam_of;
+  for (size_t i : firing) {
+    fired.points.push_back(sweep.scan.points_lidar[i]);
+    const Eigen::Vector3f p = sweep.scan.points_lidar[i].cast<float>();
+    beam_of[{p.x(), p.y(), p.z()}] = sweep.ring[i];
+  }
+  const LidarScan grouped = ScanFromCloud(fired, 1);
+  ASSERT_EQ(grouped.ring.size(), grouped.size());
+  const ScanRings rings = RingsFromLabels(grouped.points_lidar, grouped.ring);
+  EXPECT_EQ(rings.num_rings(), 16);
+  for (int r = 0; r < rings.num_rings(); ++r) {
+    const int begin = rings.ring_begin[r], end = rings.ring_begin[r + 1];
+    auto beam = [&](int i) {
+      const Eigen::Vector3f p = grouped.points_lidar[i].cast<float>();
+      return beam_of.at({p.x(), p.y(), p.z()});
+    };
+    for (int i = begin + 1; i < end; ++i) {
+      ASSERT_EQ(beam(i), beam(begin)) << "ring " << r;
+      ASSERT_GT(WrappedAzimuthStep(rings.azimuth_rad[i - 1], rings.azimuth_rad[i]), 0.0);
+    }
+  }
+}
+
 TEST(BagDrive, CameraInfoRectifiesARawImageOntoP) {
   // A point seen by a plumb_bob camera lands, in the rectified image, where P · R · X says.
   RosCameraInfo info;
@@ -393,6 +438,24 @@ TEST(BagDrive, CameraInfoRectifiesARawImageOntoP) {
     EXPECT_NEAR(maps.map_x.at<float>(v, u), raw[0].x, 0.8);
     EXPECT_NEAR(maps.map_y.at<float>(v, u), raw[0].y, 0.8);
   }
+  // The same for the equidistant (fisheye) model, against cv::fisheye::projectPoints.
+  info.distortion_model = "equidistant";
+  info.d = {0.05, -0.01, 0.002, -0.0003};
+  ASSERT_TRUE(CameraFromInfo(info, &camera).ok());
+  ASSERT_TRUE(MakeRectifyMaps(camera, &maps).ok());
+  const cv::Mat D4(info.d, true);
+  for (const Eigen::Vector3d& X : {Eigen::Vector3d(0.3, -0.2, 2.0), Eigen::Vector3d(-1, 0.5, 3)}) {
+    std::vector<cv::Point3d> object{{X.x(), X.y(), X.z()}};
+    std::vector<cv::Point2d> raw;
+    cv::fisheye::projectPoints(object, raw, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D4);
+    const Eigen::Vector3d q = camera.P_rect_02 * (camera.R_rect_00 * X).homogeneous();
+    const int u = static_cast<int>(std::lround(q.x() / q.z()));
+    const int v = static_cast<int>(std::lround(q.y() / q.z()));
+    EXPECT_NEAR(maps.map_x.at<float>(v, u), raw[0].x, 0.8);
+    EXPECT_NEAR(maps.map_y.at<float>(v, u), raw[0].y, 0.8);
+  }
+  info.d.push_back(0.0);  // five coefficients: not the equidistant model's four
+  EXPECT_THAT(CameraFromInfo(info, &camera).message(), ::testing::HasSubstr("needs 4"));
   info.distortion_model = "kannala";
   const Status unknown = CameraFromInfo(info, &camera);
   ASSERT_FALSE(unknown.ok());

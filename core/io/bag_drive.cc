@@ -120,6 +120,10 @@ class BagFrameStore : public FrameStore {
   bool compressed_;
 };
 
+// Beams of a spinning LiDAR lie at least this far apart in elevation (a VLP-16's 2°, an
+// HDL-64E's and an OS1-64's 0.33–0.53°), and one beam's returns within it [deg].
+constexpr double kRingGapDeg = 0.12;
+
 std::string SpoolPath() {
   static std::atomic<int> counter{0};
   std::error_code ec;
@@ -172,31 +176,66 @@ std::string CameraInfoTopicFor(std::string image_topic) {
 
 }  // namespace
 
+std::vector<int> RingsByElevation(const std::vector<Eigen::Vector3d>& points) {
+  const size_t n = points.size();
+  std::vector<double> elevation_deg(n);
+  for (size_t i = 0; i < n; ++i) {
+    elevation_deg[i] = std::atan2(points[i].z(), points[i].head<2>().norm()) * 180.0 / M_PI;
+  }
+  std::vector<size_t> by_elevation(n);
+  std::iota(by_elevation.begin(), by_elevation.end(), 0);
+  std::sort(by_elevation.begin(), by_elevation.end(),
+            [&](size_t a, size_t b) { return elevation_deg[a] > elevation_deg[b]; });
+  std::vector<int> ring(n, 0);
+  int current = 0;
+  for (size_t k = 1; k < n; ++k) {
+    if (elevation_deg[by_elevation[k - 1]] - elevation_deg[by_elevation[k]] > kRingGapDeg) {
+      ++current;
+    }
+    ring[by_elevation[k]] = current;
+  }
+  return ring;
+}
+
 LidarScan ScanFromCloud(const CloudPoints& cloud, uint32_t rows) {
   const size_t n = cloud.points.size();
   std::vector<int> label;
+  auto azimuth = [&](size_t i) { return std::atan2(cloud.points[i].y(), cloud.points[i].x()); };
+  // Steps between consecutive points (of `order`, from `begin` to `end`) that turn
+  // counter-clockwise (`up`) and clockwise (`down`).
+  auto count_turns = [&](const std::vector<size_t>& order, size_t begin, size_t end, int* up,
+                         int* down) {
+    *up = *down = 0;
+    for (size_t k = begin + 1; k < end; ++k) {
+      const double step = std::remainder(azimuth(order[k]) - azimuth(order[k - 1]), 2 * M_PI);
+      (step > 0 ? *up : *down) += step != 0;
+    }
+  };
+  std::vector<size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
   if (!cloud.ring.empty()) {
     label.assign(cloud.ring.begin(), cloud.ring.end());
   } else if (rows > 1 && cloud.row.size() == n) {
     label.assign(cloud.row.begin(), cloud.row.end());
+  } else {
+    // No rings given. A cloud in KITTI's order (kitti2bag's) keeps it: its rings are split
+    // where each laser's run ends, as KITTI's are. Any other order (a driver's firing order)
+    // is grouped by elevation.
+    int up = 0, down = 0;
+    count_turns(order, 0, n, &up, &down);
+    if (9 * down > up) label = RingsByElevation(cloud.points);
   }
-  std::vector<size_t> order(n);
-  std::iota(order.begin(), order.end(), 0);
   if (!label.empty()) {
     std::stable_sort(order.begin(), order.end(),
                      [&](size_t a, size_t b) { return label[a] < label[b]; });
     // Each ring in KITTI's order (counter-clockwise, azimuth growing): kept when it already runs
     // that way (KITTI's own sweeps), reversed when it runs clockwise (a spinning driver's firing
     // order), sorted by azimuth from straight ahead otherwise.
-    auto azimuth = [&](size_t i) { return std::atan2(cloud.points[i].y(), cloud.points[i].x()); };
     for (size_t begin = 0; begin < n;) {
       size_t end = begin + 1;
       while (end < n && label[order[end]] == label[order[begin]]) ++end;
       int up = 0, down = 0;
-      for (size_t k = begin + 1; k < end; ++k) {
-        const double step = std::remainder(azimuth(order[k]) - azimuth(order[k - 1]), 2 * M_PI);
-        (step > 0 ? up : down) += step != 0;
-      }
+      count_turns(order, begin, end, &up, &down);
       if (down > 9 * up) {
         std::reverse(order.begin() + begin, order.begin() + end);
       } else if (9 * down > up) {

@@ -30,11 +30,15 @@ struct BagDriveOptions {
 
 Status OpenBagDrive(const BagDriveOptions& options, Drive* drive);
 
-// A sweep from its cloud, as the features read it: points grouped by ring when the cloud says
-// (a driver's ring field; else the rows of an organized cloud), each ring in KITTI's azimuth
-// order (docs/method.md §10); the driver's per-point times kept when it wrote them. Clouds with
-// neither keep their order and are split and timed like KITTI's sweeps.
+// A sweep from its cloud, as the features read it: points grouped by ring (a driver's ring
+// field; else the rows of an organized cloud; else, unless the cloud is in KITTI's order, by
+// elevation), each ring in KITTI's azimuth order (docs/method.md §10); the driver's per-point
+// times kept when it wrote them. A cloud in KITTI's order without rings (kitti2bag's) keeps its
+// order and is split like KITTI's sweeps; without times the features time points by azimuth.
 LidarScan ScanFromCloud(const CloudPoints& cloud, uint32_t rows);
+// Each point's ring by elevation: a new ring wherever the sorted elevations leave a gap wider
+// than any one beam's spread; numbered from the top.
+std::vector<int> RingsByElevation(const std::vector<Eigen::Vector3d>& points);
 
 // The ros2msg camera: CameraInfo's R and P are KITTI's R_rect_00 and P_rect_02 (a point X in the
 // camera frame lands at P·(R·X) in the rectified image), and its K and D undistort a raw image
