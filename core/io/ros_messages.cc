@@ -386,7 +386,7 @@ Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* out) {
 
 Status DecodeTfMessage(const std::vector<uint8_t>& cdr, std::vector<RosTransform>* transforms) {
   std::vector<Eigen::Quaterniond> rotations;
-  STCALIB_RETURN_IF_ERROR(
+  const Status decoded =
       Decode(cdr, "tf2_msgs/msg/TFMessage", transforms, [&](Cdr* in, std::vector<RosTransform>* m) {
         const uint32_t n = in->Get<uint32_t>();
         if (n > cdr.size() / 64) return in->Fail();  // each takes more than 64 bytes
@@ -400,19 +400,22 @@ Status DecodeTfMessage(const std::vector<uint8_t>& cdr, std::vector<RosTransform
           t.T_parent_child.translation() = translation;
           m->push_back(t);
         }
-      }));
-  // A transform a calibration would start from must be one: finite, with a unit quaternion.
-  for (size_t k = 0; k < transforms->size(); ++k) {
+      });
+  // Nothing half-read is handed out, and a transform a calibration would start from must be one:
+  // finite, with a unit quaternion.
+  Status status = decoded;
+  for (size_t k = 0; status.ok() && k < transforms->size(); ++k) {
     RosTransform& t = (*transforms)[k];
     const double norm = rotations[k].norm();
     if (!t.T_parent_child.translation().allFinite() || !(std::abs(norm - 1.0) < 1e-3)) {
-      return Status::Error("tf2_msgs/msg/TFMessage: transform " + t.frame_id + " <- " +
-                           t.child_frame_id + " is not a rigid transform (quaternion norm " +
-                           std::to_string(norm) + ")");
+      status = Status::Error("tf2_msgs/msg/TFMessage: transform " + t.frame_id + " <- " +
+                             t.child_frame_id + " is not a rigid transform (quaternion norm " +
+                             std::to_string(norm) + ")");
     }
     t.T_parent_child.linear() = rotations[k].normalized().toRotationMatrix();
   }
-  return Status::Ok();
+  if (!status.ok()) transforms->clear();
+  return status;
 }
 
 namespace {

@@ -61,7 +61,8 @@ Status DriveMotion::CreateForDrive(const Drive& drive, DriveMotion* motion) {
                                         "oxts motion cannot be used"
                                   : drive.drive_dir + ": no oxts")
                << "; the motion comes from registering consecutive sweeps (NDT) with a constant "
-                  "velocity between them";
+                  "velocity between them"
+               << (drive.imu.empty() ? "" : ", the rotation shaped by the IMU's rates");
   return CreateFromScans(drive, motion);
 }
 
