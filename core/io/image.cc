@@ -46,7 +46,8 @@ Status MakeRectifyMaps(const CameraCalibration& camera, RectifyMaps* maps) {
   cv::eigen2cv(camera.R_rect_00, R);
   const Eigen::Matrix3d P3 = camera.P_rect_02.leftCols<3>();
   cv::eigen2cv(P3, P);
-  for (size_t k = 0; k < camera.distortion.size(); ++k) D.at<double>(static_cast<int>(k)) = camera.distortion[k];
+  for (size_t k = 0; k < camera.distortion.size(); ++k)
+    D.at<double>(static_cast<int>(k)) = camera.distortion[k];
   const cv::Size size(camera.image_width, camera.image_height);
   const size_t n = camera.distortion.size();
   if (camera.distortion_model == "equidistant") {

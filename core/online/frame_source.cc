@@ -107,9 +107,10 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
     const bool oxts = motion_.source() == DriveMotion::Source::kOxts;
     const bool odometry = motion_.source() == DriveMotion::Source::kOdometry;
     return Status::Error(drive_->drive_dir +
-                         (oxts ? "/oxts" : odometry ? " (odometry)" : "/velodyne_points") +
-                         ": frame " +
-                         std::to_string(frame) + " falls in a gap of " +
+                         (oxts       ? "/oxts"
+                          : odometry ? " (odometry)"
+                                     : "/velodyne_points") +
+                         ": frame " + std::to_string(frame) + " falls in a gap of " +
                          std::to_string(oxts_gap_s) + " s between motion measurements (more than " +
                          std::to_string(options_.max_oxts_gap_s) + " s): no motion model");
   }
