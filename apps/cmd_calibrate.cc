@@ -553,11 +553,6 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
 }
 
 std::string CalibrateFlagsError() {
-  // --bag wins over a --drive (which a flagfile may have set).
-  if (FLAGS_bag.empty() && FLAGS_drive.empty()) return "give --drive or --bag";
-  if (!FLAGS_bag.empty() && (FLAGS_image_topic.empty() || FLAGS_cloud_topic.empty())) {
-    return "--bag needs --image_topic and --cloud_topic";
-  }
   for (const auto& [name, value] : {std::pair{"--loss", &FLAGS_loss}}) {
     RefineOptions::Loss loss;
     if (!ParseLoss(*value, &loss)) return std::string(name) + " must be " + LossChoices();
@@ -576,6 +571,12 @@ std::string CalibrateFlagsError() {
 }
 
 int RunCalibrate() {
+  // --bag wins over a --drive (which a flagfile may have set).
+  if (FLAGS_bag.empty() && FLAGS_drive.empty())
+    return UsageError("calibrate", "give --drive or --bag");
+  if (!FLAGS_bag.empty() && (FLAGS_image_topic.empty() || FLAGS_cloud_topic.empty())) {
+    return UsageError("calibrate", "--bag needs --image_topic and --cloud_topic");
+  }
   const std::string flags_error = CalibrateFlagsError();
   if (!flags_error.empty()) return UsageError("calibrate", flags_error);
   CalibrateOutcome outcome;
