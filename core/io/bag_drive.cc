@@ -174,8 +174,8 @@ std::string CameraInfoTopicFor(std::string image_topic) {
          "/camera_info";
 }
 
-}  // namespace
-
+// Each point's ring by elevation: a new ring wherever the sorted elevations leave a gap wider
+// than any one beam's spread; numbered from the top.
 std::vector<int> RingsByElevation(const std::vector<Eigen::Vector3d>& points) {
   const size_t n = points.size();
   std::vector<double> elevation_deg(n);
@@ -196,6 +196,8 @@ std::vector<int> RingsByElevation(const std::vector<Eigen::Vector3d>& points) {
   }
   return ring;
 }
+
+}  // namespace
 
 LidarScan ScanFromCloud(const CloudPoints& cloud, uint32_t rows) {
   const size_t n = cloud.points.size();

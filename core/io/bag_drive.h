@@ -36,9 +36,6 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive);
 // times kept when it wrote them. A cloud in KITTI's order without rings (kitti2bag's) keeps its
 // order and is split like KITTI's sweeps; without times the features time points by azimuth.
 LidarScan ScanFromCloud(const CloudPoints& cloud, uint32_t rows);
-// Each point's ring by elevation: a new ring wherever the sorted elevations leave a gap wider
-// than any one beam's spread; numbered from the top.
-std::vector<int> RingsByElevation(const std::vector<Eigen::Vector3d>& points);
 
 // The ros2msg camera: CameraInfo's R and P are KITTI's R_rect_00 and P_rect_02 (a point X in the
 // camera frame lands at P·(R·X) in the rectified image), and its K and D undistort a raw image

@@ -40,10 +40,11 @@ struct ImuSample {
   Eigen::Vector3d rate_rad_s = Eigen::Vector3d::Zero();
 };
 
-// A KITTI raw synced drive: image_02/, velodyne_points/ and (optionally) oxts/, each with data/
-// and timestamps.txt, plus the three calibration files in `calib_dir` (by default the drive's
-// parent folder). Frame i is the i-th file of image_02/data in name order; every sensor must
-// hold the same frame names and one stamp per frame.
+// A drive: KITTI raw synced (OpenDrive) or a ROS 2 bag read as one (OpenBagDrive, whose `store`
+// serves the images and sweeps). KITTI's: image_02/, velodyne_points/ and (optionally) oxts/, each
+// with data/ and timestamps.txt, plus the three calibration files in `calib_dir` (by default the
+// drive's parent folder). Frame i is the i-th file of image_02/data in name order; every sensor
+// must hold the same frame names and one stamp per frame.
 struct Drive {
   std::string drive_dir;
   std::string calib_dir;
