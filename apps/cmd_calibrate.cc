@@ -97,13 +97,7 @@ CalibrateJob CalibrateJobFromFlags() {
   job.drive_dir = FLAGS_drive;
   job.calib_dir = FLAGS_calib_dir;
   job.init_calib = FLAGS_init_calib;
-  job.bag.bag_dir = FLAGS_bag;
-  job.bag.image_topic = FLAGS_image_topic;
-  job.bag.cloud_topic = FLAGS_cloud_topic;
-  job.bag.camera_info_topic = FLAGS_camera_info_topic;
-  job.bag.odom_topic = FLAGS_odom_topic;
-  job.bag.imu_topic = FLAGS_imu_topic;
-  job.bag.require_tf_extrinsic = FLAGS_init_calib.empty();
+  job.bag = BagOptionsFromFlags();
   job.out_dir = FLAGS_out;
   job.perturb_rot_deg = FLAGS_perturb_rot_deg;
   job.perturb_trans_m = FLAGS_perturb_trans_m;

@@ -15,14 +15,16 @@ namespace stcalib::cli {
 
 int RunCheck() {
   const char* kCommand = "check";
-  if (FLAGS_drive.empty()) return UsageError(kCommand, "--drive=DRIVE_DIR is required");
+  if (FLAGS_drive.empty() && FLAGS_bag.empty()) {
+    return UsageError(kCommand, "--drive=DRIVE_DIR or --bag=DIR is required");
+  }
   HealthCheckOptions options;
   options.window_frames = FLAGS_window_frames;
   options.min_health = FLAGS_min_health;
   Status status = options.Validate();
   if (!status.ok()) return UsageError(kCommand, status.message());
   Drive drive;
-  status = OpenDriveFromFlags(&drive);
+  status = OpenDriveOrBagFromFlags(&drive);
   if (!status.ok()) return ReportError(kCommand, status);
 
   CalibrationState calibration;

@@ -37,7 +37,7 @@ int RunFeatures() {
   if (FLAGS_out.empty()) return UsageError("features", "--out=DIR is required");
   if (FLAGS_frame < 0) return UsageError("features", "--frame must be >= 0");
   Drive drive;
-  Status status = OpenDriveFromFlags(&drive);
+  Status status = OpenDriveOrBagFromFlags(&drive);
   if (status.ok()) status = drive.CheckFrame(FLAGS_frame);
   if (!status.ok()) return ReportError("features", status);
   DriveMotion motion;

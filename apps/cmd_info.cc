@@ -60,7 +60,7 @@ void PrintTransform(const char* name, const Rigid3d& T) {
 
 int RunInfo() {
   Drive drive;
-  const Status status = OpenDriveFromFlags(&drive);
+  const Status status = OpenDriveOrBagFromFlags(&drive);
   if (!status.ok()) return ReportError("info", status);
 
   std::printf("drive        %s\n", drive.drive_dir.c_str());
@@ -118,10 +118,14 @@ int RunInfo() {
     std::printf("oxts         mean speed %.2f m/s, first fix lat %.6f lon %.6f\n",
                 speed / drive.oxts.size(), drive.oxts.front().lat, drive.oxts.front().lon);
   }
-  std::printf("calibration files\n");
-  PrintTransform("T_camera_lidar (calib_velo_to_cam.txt)", drive.T_camera_lidar);
+  const bool bag = drive.store != nullptr;
+  std::printf("calibration %s\n", bag ? "(the bag's tf)" : "files");
+  PrintTransform(bag ? "T_camera_lidar" : "T_camera_lidar (calib_velo_to_cam.txt)",
+                 drive.T_camera_lidar);
   if (drive.has_imu_calibration) {
-    PrintTransform("T_lidar_imu (calib_imu_to_velo.txt)", drive.T_lidar_imu);
+    PrintTransform(
+        bag ? "T_lidar_imu (odometry or IMU frame)" : "T_lidar_imu (calib_imu_to_velo.txt)",
+        drive.T_lidar_imu);
   }
   const auto& P = drive.camera.P_rect_02;
   std::printf("  P_rect_02 fx %.3f fy %.3f cx %.3f cy %.3f, tx %.4f\n", P(0, 0), P(1, 1), P(0, 2),

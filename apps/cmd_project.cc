@@ -13,7 +13,7 @@ int RunProject() {
   if (FLAGS_out.empty()) return UsageError("project", "--out=FILE.png is required");
   if (FLAGS_frame < 0) return UsageError("project", "--frame must be >= 0");
   Drive drive;
-  Status status = OpenDriveFromFlags(&drive);
+  Status status = OpenDriveOrBagFromFlags(&drive);
   if (!status.ok()) return ReportError("project", status);
   const size_t frame = static_cast<size_t>(FLAGS_frame);
   status = drive.CheckFrame(frame);

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/features/image_features.h"
+#include "core/io/bag_drive.h"
 #include "core/io/drive.h"
 #include "core/types/calibration.h"
 #include "core/types/status.h"
@@ -43,6 +44,11 @@ Status StartingCalibration(const Drive& drive, const std::string& init_calib,
                            Rigid3d* T_camera_lidar);
 // Opens --drive with --calib_dir.
 Status OpenDriveFromFlags(Drive* drive);
+// --bag and its topic flags; the bag's tf must hold the camera–LiDAR transform unless
+// --init_calib gives the start.
+BagDriveOptions BagOptionsFromFlags();
+// Opens --bag (with its topics) when given, else --drive with --calib_dir.
+Status OpenDriveOrBagFromFlags(Drive* drive);
 // --detector, --min_segment_px and --max_edge_density into `options` (features, calibrate, demo
 // and check read the same image edges); an error naming the flag for an unknown detector, with
 // `options` untouched.

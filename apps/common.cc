@@ -82,6 +82,23 @@ Status StartingCalibration(const Drive& drive, const std::string& init_calib,
 
 Status OpenDriveFromFlags(Drive* drive) { return OpenDrive(FLAGS_drive, FLAGS_calib_dir, drive); }
 
+BagDriveOptions BagOptionsFromFlags() {
+  BagDriveOptions options;
+  options.bag_dir = FLAGS_bag;
+  options.image_topic = FLAGS_image_topic;
+  options.cloud_topic = FLAGS_cloud_topic;
+  options.camera_info_topic = FLAGS_camera_info_topic;
+  options.odom_topic = FLAGS_odom_topic;
+  options.imu_topic = FLAGS_imu_topic;
+  options.require_tf_extrinsic = FLAGS_init_calib.empty();
+  return options;
+}
+
+Status OpenDriveOrBagFromFlags(Drive* drive) {
+  if (FLAGS_bag.empty()) return OpenDriveFromFlags(drive);
+  return OpenBagDrive(BagOptionsFromFlags(), drive);
+}
+
 Status ImageOptionsFromFlags(ImageFeatureOptions* options) {
   ImageFeatureOptions::Detector detector;
   if (!ParseDetector(FLAGS_detector, &detector)) {

@@ -10,18 +10,18 @@ DEFINE_string(calib_dir, "",
               "folder with calib_cam_to_cam.txt, calib_velo_to_cam.txt, calib_imu_to_velo.txt "
               "(default: the drive's parent folder)");
 DEFINE_string(bag, "",
-              "ROS 2 bag folder (metadata.yaml with .mcap or .db3 files): calibrate reads it "
-              "instead of --drive; convert writes the drive there");
-DEFINE_string(image_topic, "", "calibrate --bag: sensor_msgs/msg/Image or CompressedImage topic");
-DEFINE_string(cloud_topic, "", "calibrate --bag: sensor_msgs/msg/PointCloud2 topic");
+              "ROS 2 bag folder (metadata.yaml with .mcap or .db3 files): info, project, "
+              "features, check and calibrate read it instead of --drive; convert writes there");
+DEFINE_string(image_topic, "", "--bag: sensor_msgs/msg/Image or CompressedImage topic");
+DEFINE_string(cloud_topic, "", "--bag: sensor_msgs/msg/PointCloud2 topic");
 DEFINE_string(camera_info_topic, "",
-              "calibrate --bag: sensor_msgs/msg/CameraInfo topic (default: beside the image "
+              "--bag: sensor_msgs/msg/CameraInfo topic (default: beside the image "
               "topic, NS/camera_info)");
 DEFINE_string(odom_topic, "",
-              "calibrate --bag: nav_msgs/msg/Odometry topic for the motion (default: none, the "
+              "--bag: nav_msgs/msg/Odometry topic for the motion (default: none, the "
               "sweeps are registered)");
 DEFINE_string(imu_topic, "",
-              "calibrate --bag: sensor_msgs/msg/Imu topic whose rates shape the rotation between "
+              "--bag: sensor_msgs/msg/Imu topic whose rates shape the rotation between "
               "registered sweeps (without --odom_topic)");
 DEFINE_int32(frame, 0, "frame index (0-based, in file-name order)");
 DEFINE_string(out, "",

@@ -27,15 +27,16 @@ struct Subcommand {
 const std::vector<Subcommand>& Subcommands() {
   static const std::vector<Subcommand> kSubcommands = {
       {"info",
-       "--drive=DRIVE_DIR [--calib_dir=DIR]",
-       "frames, sensor rates, stamp gaps, points per frame and the calibration of a drive",
+       "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T)",
+       "frames, sensor rates, stamp gaps, points per frame and the calibration of a drive or bag",
        &RunInfo,
-       {"drive", "calib_dir"}},
+       {"drive", "calib_dir", "bag", "image_topic", "cloud_topic"}},
       {"project",
-       "--drive=DRIVE_DIR --frame=I --out=FILE.png [--calib_dir=DIR]",
+       "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T) "
+       "--frame=I --out=FILE.png",
        "LiDAR points of one frame projected on its image, coloured by depth",
        &RunProject,
-       {"drive", "frame", "out", "calib_dir"}},
+       {"drive", "frame", "out", "calib_dir", "bag", "image_topic", "cloud_topic"}},
       {"simulate",
        "--out=DIR [--frames=N (40)] [--seed=S (1)] [--time_offset_s=X (0)] "
        "[--dynamic_objects=K (6)] [--scene=urban|poles|open] [--lidar_hz=10] "
@@ -46,10 +47,12 @@ const std::vector<Subcommand>& Subcommands() {
        {"out", "frames", "seed", "time_offset_s", "dynamic_objects", "scene", "camera", "lidar",
         "distortion_k1", "lidar_hz", "oxts_white_position_m", "oxts_error_scale"}},
       {"features",
-       "--drive=DRIVE_DIR --frame=I --out=DIR [--calib_dir=DIR]",
+       "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T) "
+       "--frame=I --out=DIR",
        "image edge mask and IDT, LiDAR edge points (vertical, horizontal, dynamic) as PNGs",
        &RunFeatures,
-       {"drive", "frame", "out", "calib_dir", "detector"}},
+       {"drive", "frame", "out", "calib_dir", "detector", "bag", "image_topic", "cloud_topic",
+        "odom_topic"}},
       {"calibrate",
        "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T "
        "[--camera_info_topic=T] [--odom_topic=T | --imu_topic=T]) [--init_calib=FILE] "
@@ -87,7 +90,8 @@ const std::vector<Subcommand>& Subcommands() {
        &RunEvalTemporal,
        {"drive", "lidar_decimation", "lidar_delay_s", "eval_max_range_m", "out"}},
       {"check",
-       "--drive=DRIVE_DIR [--calib_dir=DIR] [--init_calib=FILE] [--perturb_rot_deg=D] "
+       "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T) "
+       "[--init_calib=FILE] [--perturb_rot_deg=D] "
        "[--perturb_trans_m=M] [--perturb_time_s=S (added to the stored δ)] [--seed=S] "
        "[--first_frame=I] "
        "[--num_frames=N] [--out=DIR] "
@@ -96,8 +100,9 @@ const std::vector<Subcommand>& Subcommands() {
        "frames; exit 0 when it holds, 1 "
        "when it is off, with the evidence",
        &RunCheck,
-       {"drive", "calib_dir", "init_calib", "perturb_rot_deg", "perturb_trans_m", "perturb_time_s",
-        "seed", "first_frame", "num_frames", "out", "min_health"}},
+       {"drive", "calib_dir", "bag", "image_topic", "cloud_topic", "odom_topic", "init_calib",
+        "perturb_rot_deg", "perturb_trans_m", "perturb_time_s", "seed", "first_frame", "num_frames",
+        "out", "min_health"}},
       {"convert",
        "--drive=DRIVE_DIR [--calib_dir=DIR] --bag=OUT_DIR",
        "a drive written as a ROS 2 bag (MCAP): image, camera info, cloud with rings and point "

@@ -1060,6 +1060,21 @@ TEST(Cli, KittiThroughItsBagGivesTheDrivesEstimate) {
   EXPECT_NEAR(b["agreement_with_drive_calibration"]["rotation_deg"].get<double>(),
               d["agreement_with_drive_calibration"]["rotation_deg"].get<double>(), 1e-6);
 
+  // The other readers take the bag too: check on it says what check on the drive says.
+  const std::string topics =
+      " --bag=" + bag + " --image_topic=/camera/image_raw --cloud_topic=/lidar/points";
+  const RunResult check_bag = RunStcalib("check" + topics + " --odom_topic=/odom --num_frames=12");
+  const RunResult check_drive =
+      RunStcalib("check --drive=" + testing::KittiDriveDir() + " --num_frames=12");
+  EXPECT_EQ(check_bag.exit_code, check_drive.exit_code);
+  auto verdict = [](const std::string& output) {
+    return output.substr(output.find("mean health"));
+  };
+  EXPECT_EQ(verdict(check_bag.output), verdict(check_drive.output)) << check_bag.output;
+  EXPECT_EQ(RunStcalib("project" + topics + " --frame=3 --out=" + tmp.path() + "/p.png").exit_code,
+            0);
+  EXPECT_THAT(RunStcalib("info" + topics).output, HasSubstr("the bag's tf"));
+
   // A topic the bag does not have: the error lists what it has.
   const RunResult wrong = RunStcalib(
       "calibrate --bag=" + bag + " --image_topic=/camera/image_rect --cloud_topic=/lidar/points");
@@ -1075,14 +1090,14 @@ TEST(Cli, KittiThroughItsBagGivesTheDrivesEstimate) {
   EXPECT_THAT(again.output, HasSubstr("exists and is not empty"));
 }
 
-
 // An Ouster OS1-64 and a raw camera with k1 = −0.3, δ = +30 ms, through a bag written as
 // ouster-ros writes clouds (organized, uint32 ns times, stamped at the sweep's start).
 // Measured: 0.059° (this seed; from the drive itself 0.023°), docs/results.md#ros-2-bags.
 TEST(Cli, CalibratesAnOusterBagWithARawCamera) {
   testing::ScopedTempDir tmp;
   const std::string drive = SimulateDrive(
-      tmp.path(), "--frames=20 --seed=104 --time_offset_s=0.03 --lidar=os1-64 --distortion_k1=-0.3");
+      tmp.path(),
+      "--frames=20 --seed=104 --time_offset_s=0.03 --lidar=os1-64 --distortion_k1=-0.3");
   ASSERT_FALSE(drive.empty());
   const std::string bag = tmp.path() + "/bag";
   const RunResult convert = RunStcalib("convert --drive=" + drive + " --bag=" + bag);
