@@ -420,9 +420,8 @@ TEST(BagDrive, CameraInfoRectifiesARawImageOntoP) {
   info.R = Eigen::AngleAxisd(0.02, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix();
   info.P << 480, 0, 318, 0, 0, 480, 242, 0, 0, 0, 1, 0;
   CameraCalibration camera;
-  ASSERT_TRUE(CameraFromInfo(info, &camera).ok());
   RectifyMaps maps;
-  ASSERT_TRUE(MakeRectifyMaps(camera, &maps).ok());
+  ASSERT_TRUE(CameraFromInfo(info, &camera, &maps).ok());
   ASSERT_FALSE(maps.empty());
   cv::Mat K, D(info.d, true);
   cv::eigen2cv(info.K, K);
@@ -441,8 +440,7 @@ TEST(BagDrive, CameraInfoRectifiesARawImageOntoP) {
   // The same for the equidistant (fisheye) model, against cv::fisheye::projectPoints.
   info.distortion_model = "equidistant";
   info.d = {0.05, -0.01, 0.002, -0.0003};
-  ASSERT_TRUE(CameraFromInfo(info, &camera).ok());
-  ASSERT_TRUE(MakeRectifyMaps(camera, &maps).ok());
+  ASSERT_TRUE(CameraFromInfo(info, &camera, &maps).ok());
   const cv::Mat D4(info.d, true);
   for (const Eigen::Vector3d& X : {Eigen::Vector3d(0.3, -0.2, 2.0), Eigen::Vector3d(-1, 0.5, 3)}) {
     std::vector<cv::Point3d> object{{X.x(), X.y(), X.z()}};
@@ -455,9 +453,9 @@ TEST(BagDrive, CameraInfoRectifiesARawImageOntoP) {
     EXPECT_NEAR(maps.map_y.at<float>(v, u), raw[0].y, 0.8);
   }
   info.d.push_back(0.0);  // five coefficients: not the equidistant model's four
-  EXPECT_THAT(CameraFromInfo(info, &camera).message(), ::testing::HasSubstr("needs 4"));
+  EXPECT_THAT(CameraFromInfo(info, &camera, &maps).message(), ::testing::HasSubstr("needs 4"));
   info.distortion_model = "kannala";
-  const Status unknown = CameraFromInfo(info, &camera);
+  const Status unknown = CameraFromInfo(info, &camera, &maps);
   ASSERT_FALSE(unknown.ok());
   EXPECT_THAT(unknown.message(), ::testing::HasSubstr("\"kannala\" is not supported"));
 }

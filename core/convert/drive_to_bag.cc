@@ -32,7 +32,6 @@ RosPointCloud MakeCloud(const LidarScan& scan, const ScanRings& rings,
                         CloudLayout layout) {
   RosPointCloud cloud;
   cloud.frame_id = kLidarFrame;
-  cloud.stamp_ns = stamp_ns;
   const size_t n = scan.size();
   const int num_rings = rings.num_rings();
   auto xyz = [&](size_t i, uint8_t* p) {
@@ -42,88 +41,82 @@ RosPointCloud MakeCloud(const LidarScan& scan, const ScanRings& rings,
     Put(p, v, sizeof(v));
   };
   auto intensity = [&](size_t i) { return scan.reflectance.empty() ? 0.0f : scan.reflectance[i]; };
-  if (layout == CloudLayout::kKitti) {
-    cloud.height = 1;
-    cloud.width = static_cast<uint32_t>(n);
-    cloud.fields = {{"x", 0, 7, 1},          {"y", 4, 7, 1},     {"z", 8, 7, 1},
-                    {"intensity", 12, 7, 1}, {"ring", 16, 4, 1}, {"time", 24, 8, 1}};
-    cloud.point_step = 32;
-    cloud.data.assign(n * cloud.point_step, 0);
-    for (size_t i = 0; i < n; ++i) {
-      uint8_t* p = cloud.data.data() + i * cloud.point_step;
-      const float value = intensity(i);
-      xyz(i, p);
-      Put(p + 12, &value, 4);
-      Put(p + 16, &rings.ring[i], 2);
-      Put(p + 24, &time_s[i], 8);
-    }
-  } else {
-    // Stamped at the sweep's start: the first instant of the spin, half a sweep before the
-    // stamp, which the KITTI layout puts where the head faces forward.
-    const int64_t start_ns = stamp_ns - std::llround(0.5e9 * sweep_s);
-    const double shift_s = 1e-9 * static_cast<double>(stamp_ns - start_ns);
-    cloud.stamp_ns = start_ns;
+  // Stamped at the sweep's start (Velodyne's and Ouster's drivers): the first instant of the
+  // spin, half a sweep before the stamp, which KITTI's layout puts where the head faces forward.
+  const int64_t start_ns =
+      layout == CloudLayout::kKitti ? stamp_ns : stamp_ns - std::llround(0.5e9 * sweep_s);
+  const double shift_s = 1e-9 * static_cast<double>(stamp_ns - start_ns);
+  cloud.stamp_ns = start_ns;
+  if (layout != CloudLayout::kOuster) {
+    // Unorganized: x y z intensity (float32) and ring (uint16), then the time, KITTI's in
+    // float64 seconds in its point order, Velodyne's in float32 in firing order (by capture
+    // time, the beams of one firing from the lowest up; ring 0 the lowest beam).
+    const bool kitti = layout == CloudLayout::kKitti;
     std::vector<size_t> order(n);
     for (size_t i = 0; i < n; ++i) order[i] = i;
-    if (layout == CloudLayout::kVelodyne) {
-      // Firing order: by capture time, the beams of one firing from the lowest up.
+    if (!kitti) {
       std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
         if (time_s[a] != time_s[b]) return time_s[a] < time_s[b];
         return rings.elevation_rank[rings.ring[a]] > rings.elevation_rank[rings.ring[b]];
       });
-      cloud.height = 1;
-      cloud.width = static_cast<uint32_t>(n);
-      cloud.fields = {{"x", 0, 7, 1},          {"y", 4, 7, 1},     {"z", 8, 7, 1},
-                      {"intensity", 12, 7, 1}, {"ring", 16, 4, 1}, {"time", 18, 7, 1}};
-      cloud.point_step = 22;
-      cloud.data.assign(n * cloud.point_step, 0);
-      for (size_t k = 0; k < n; ++k) {
-        const size_t i = order[k];
-        uint8_t* p = cloud.data.data() + k * cloud.point_step;
-        const float value = intensity(i);
-        const uint16_t ring =
-            static_cast<uint16_t>(num_rings - 1 - rings.elevation_rank[rings.ring[i]]);
+    }
+    cloud.height = 1;
+    cloud.width = static_cast<uint32_t>(n);
+    cloud.fields = {{"x", 0, 7, 1},     {"y", 4, 7, 1},
+                    {"z", 8, 7, 1},     {"intensity", 12, 7, 1},
+                    {"ring", 16, 4, 1}, {"time", kitti ? 24u : 18u, uint8_t(kitti ? 8 : 7), 1}};
+    cloud.point_step = kitti ? 32 : 22;
+    cloud.data.assign(n * cloud.point_step, 0);
+    for (size_t k = 0; k < n; ++k) {
+      const size_t i = order[k];
+      uint8_t* p = cloud.data.data() + k * cloud.point_step;
+      const float value = intensity(i);
+      const uint16_t ring =
+          kitti ? rings.ring[i]
+                : static_cast<uint16_t>(num_rings - 1 - rings.elevation_rank[rings.ring[i]]);
+      xyz(i, p);
+      Put(p + 12, &value, 4);
+      Put(p + 16, &ring, 2);
+      if (kitti) {
+        Put(p + 24, &time_s[i], 8);
+      } else {
         const float time = static_cast<float>(time_s[i] + shift_s);
-        xyz(i, p);
-        Put(p + 12, &value, 4);
-        Put(p + 16, &ring, 2);
         Put(p + 18, &time, 4);
       }
-    } else {
-      // A row per beam (top first), a column per firing in spin order (clockwise: the azimuth
-      // falls from +π), as the sensor's fixed azimuth steps give them.
-      const int columns = rings.azimuth_step_rad > 0
-                              ? static_cast<int>(std::lround(2 * M_PI / rings.azimuth_step_rad))
-                              : 1024;
-      cloud.height = static_cast<uint32_t>(num_rings);
-      cloud.width = static_cast<uint32_t>(columns);
-      cloud.fields = {{"x", 0, 7, 1},          {"y", 4, 7, 1},        {"z", 8, 7, 1},
-                      {"intensity", 16, 7, 1}, {"t", 20, 6, 1},       {"reflectivity", 24, 4, 1},
-                      {"ring", 26, 4, 1},      {"ambient", 28, 4, 1}, {"range", 32, 6, 1}};
-      cloud.point_step = 48;
-      cloud.data.assign(size_t{cloud.height} * cloud.width * cloud.point_step, 0);
-      for (size_t i = 0; i < n; ++i) {
-        const int row = rings.elevation_rank[rings.ring[i]];
-        const double fraction = (M_PI - rings.azimuth_rad[i]) / (2 * M_PI);
-        const int column = std::clamp(static_cast<int>(fraction * columns), 0, columns - 1);
-        uint8_t* p =
-            cloud.data.data() + (static_cast<size_t>(row) * columns + column) * cloud.point_step;
-        uint32_t range_mm;
-        std::memcpy(&range_mm, p + 32, 4);
-        if (range_mm != 0) continue;  // a second return in one cell: the first stays
-        const float value = intensity(i) * 255.0f;
-        const uint32_t t_ns =
-            static_cast<uint32_t>(std::max<int64_t>(0, std::llround(1e9 * (time_s[i] + shift_s))));
-        const uint16_t reflectivity = static_cast<uint16_t>(value),
-                       ring = static_cast<uint16_t>(row);
-        range_mm = std::max<uint32_t>(1, static_cast<uint32_t>(1000 * scan.points_lidar[i].norm()));
-        xyz(i, p);
-        Put(p + 16, &value, 4);
-        Put(p + 20, &t_ns, 4);
-        Put(p + 24, &reflectivity, 2);
-        Put(p + 26, &ring, 2);
-        Put(p + 32, &range_mm, 4);
-      }
+    }
+  } else {
+    // A row per beam (top first), a column per firing in spin order (clockwise: the azimuth
+    // falls from +π), as the sensor's fixed azimuth steps give them.
+    const int columns = rings.azimuth_step_rad > 0
+                            ? static_cast<int>(std::lround(2 * M_PI / rings.azimuth_step_rad))
+                            : 1024;
+    cloud.height = static_cast<uint32_t>(num_rings);
+    cloud.width = static_cast<uint32_t>(columns);
+    cloud.fields = {{"x", 0, 7, 1},          {"y", 4, 7, 1},        {"z", 8, 7, 1},
+                    {"intensity", 16, 7, 1}, {"t", 20, 6, 1},       {"reflectivity", 24, 4, 1},
+                    {"ring", 26, 4, 1},      {"ambient", 28, 4, 1}, {"range", 32, 6, 1}};
+    cloud.point_step = 48;
+    cloud.data.assign(size_t{cloud.height} * cloud.width * cloud.point_step, 0);
+    for (size_t i = 0; i < n; ++i) {
+      const int row = rings.elevation_rank[rings.ring[i]];
+      const double fraction = (M_PI - rings.azimuth_rad[i]) / (2 * M_PI);
+      const int column = std::clamp(static_cast<int>(fraction * columns), 0, columns - 1);
+      uint8_t* p =
+          cloud.data.data() + (static_cast<size_t>(row) * columns + column) * cloud.point_step;
+      uint32_t range_mm;
+      std::memcpy(&range_mm, p + 32, 4);
+      if (range_mm != 0) continue;  // a second return in one cell: the first stays
+      const float value = intensity(i) * 255.0f;
+      const uint32_t t_ns =
+          static_cast<uint32_t>(std::max<int64_t>(0, std::llround(1e9 * (time_s[i] + shift_s))));
+      const uint16_t reflectivity = static_cast<uint16_t>(value), ring = static_cast<uint16_t>(row);
+      range_mm = std::max<uint32_t>(1, static_cast<uint32_t>(1000 * scan.points_lidar[i].norm()));
+      xyz(i, p);
+      Put(p + 16, &value, 4);
+      Put(p + 20, &t_ns, 4);
+      Put(p + 24, &reflectivity, 2);
+      Put(p + 26, &ring, 2);
+      Put(p + 32, &range_mm, 4);
     }
   }
   cloud.row_step = cloud.point_step * cloud.width;
@@ -191,12 +184,12 @@ Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, CloudLayo
     ++counts[topic];
   };
   const bool odometry = drive.has_oxts && drive.has_imu_calibration;
-  channel("/tf_static", "tf2_msgs/msg/TFMessage");
-  channel(kBagImageTopic, "sensor_msgs/msg/Image");
-  channel(kBagCameraInfoTopic, "sensor_msgs/msg/CameraInfo");
-  channel(kBagCloudTopic, "sensor_msgs/msg/PointCloud2");
-  if (odometry) channel(kBagOdometryTopic, "nav_msgs/msg/Odometry");
-  if (odometry) channel(kBagImuTopic, "sensor_msgs/msg/Imu");
+  channel("/tf_static", kRosTfMessageType);
+  channel(kBagImageTopic, kRosImageType);
+  channel(kBagCameraInfoTopic, kRosCameraInfoType);
+  channel(kBagCloudTopic, kRosPointCloud2Type);
+  if (odometry) channel(kBagOdometryTopic, kRosOdometryType);
+  if (odometry) channel(kBagImuTopic, kRosImuType);
 
   const size_t n = drive.NumFrames();
   if (n == 0) return Status::Error(drive.drive_dir + ": no frames to convert");

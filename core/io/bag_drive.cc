@@ -22,14 +22,6 @@ namespace fs = std::filesystem;
 namespace stcalib {
 namespace {
 
-constexpr char kImageType[] = "sensor_msgs/msg/Image";
-constexpr char kCompressedType[] = "sensor_msgs/msg/CompressedImage";
-constexpr char kCloudType[] = "sensor_msgs/msg/PointCloud2";
-constexpr char kInfoType[] = "sensor_msgs/msg/CameraInfo";
-constexpr char kOdometryType[] = "nav_msgs/msg/Odometry";
-constexpr char kTfType[] = "tf2_msgs/msg/TFMessage";
-constexpr char kImuType[] = "sensor_msgs/msg/Imu";
-
 // A message copied to the spool file.
 struct Spooled {
   uint64_t offset = 0, size = 0;
@@ -202,7 +194,10 @@ std::vector<int> RingsByElevation(const std::vector<Eigen::Vector3d>& points) {
 LidarScan ScanFromCloud(const CloudPoints& cloud, uint32_t rows) {
   const size_t n = cloud.points.size();
   std::vector<int> label;
-  auto azimuth = [&](size_t i) { return std::atan2(cloud.points[i].y(), cloud.points[i].x()); };
+  std::vector<double> azimuth_rad(n);
+  for (size_t i = 0; i < n; ++i)
+    azimuth_rad[i] = std::atan2(cloud.points[i].y(), cloud.points[i].x());
+  auto azimuth = [&](size_t i) { return azimuth_rad[i]; };
   // Steps between consecutive points (of `order`, from `begin` to `end`) that turn
   // counter-clockwise (`up`) and clockwise (`down`).
   auto count_turns = [&](const std::vector<size_t>& order, size_t begin, size_t end, int* up,
@@ -263,7 +258,7 @@ LidarScan ScanFromCloud(const CloudPoints& cloud, uint32_t rows) {
   return scan;
 }
 
-Status CameraFromInfo(const RosCameraInfo& info, CameraCalibration* camera) {
+Status CameraFromInfo(const RosCameraInfo& info, CameraCalibration* camera, RectifyMaps* maps) {
   *camera = CameraCalibration();
   camera->image_width = static_cast<int>(info.width);
   camera->image_height = static_cast<int>(info.height);
@@ -283,11 +278,8 @@ Status CameraFromInfo(const RosCameraInfo& info, CameraCalibration* camera) {
     camera->distortion_model = info.distortion_model;
     camera->K = info.K;
     camera->distortion = info.d;
-    RectifyMaps maps;
-    STCALIB_RETURN_IF_ERROR(
-        MakeRectifyMaps(*camera, &maps).WithContext("sensor_msgs/msg/CameraInfo: "));
   }
-  return Status::Ok();
+  return MakeRectifyMaps(*camera, maps).WithContext(std::string(kRosCameraInfoType) + ": ");
 }
 
 Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
@@ -338,14 +330,14 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
         const std::string& topic = m.topic->name;
         const std::string& type = m.topic->type;
         if (topic == options.image_topic) {
-          if (type != kImageType && type != kCompressedType) {
-            return fail(m, Status::Error(std::string("not an image type (") + kImageType + ", " +
-                                         kCompressedType + ")"));
+          if (type != kRosImageType && type != kRosCompressedImageType) {
+            return fail(m, Status::Error(std::string("not an image type (") + kRosImageType + ", " +
+                                         kRosCompressedImageType + ")"));
           }
           spool_message(m, &images, &image_frame);
         } else if (topic == options.cloud_topic) {
-          if (type != kCloudType) {
-            return fail(m, Status::Error(std::string("not a ") + kCloudType));
+          if (type != kRosPointCloud2Type) {
+            return fail(m, Status::Error(std::string("not a ") + kRosPointCloud2Type));
           }
           spool_message(m, &clouds, &cloud_frame);
           if (!failure.ok()) return;
@@ -361,25 +353,27 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
             clouds.back().middle_ns += std::llround(0.5e9 * (*first + *last));
           }
         } else if (topic == info_topic && !have_info) {
-          if (type != kInfoType) return fail(m, Status::Error(std::string("not a ") + kInfoType));
+          if (type != kRosCameraInfoType)
+            return fail(m, Status::Error(std::string("not a ") + kRosCameraInfoType));
           const Status status = DecodeCameraInfo(m.data, &info);
           if (!status.ok()) return fail(m, status);
           have_info = true;
         } else if (!options.odom_topic.empty() && topic == options.odom_topic) {
-          if (type != kOdometryType) {
-            return fail(m, Status::Error(std::string("not a ") + kOdometryType));
+          if (type != kRosOdometryType) {
+            return fail(m, Status::Error(std::string("not a ") + kRosOdometryType));
           }
           RosOdometry o;
           const Status status = DecodeOdometry(m.data, &o);
           if (!status.ok()) return fail(m, status);
           odometry.push_back(o);
         } else if (!options.imu_topic.empty() && topic == options.imu_topic) {
-          if (type != kImuType) return fail(m, Status::Error(std::string("not a ") + kImuType));
+          if (type != kRosImuType)
+            return fail(m, Status::Error(std::string("not a ") + kRosImuType));
           RosImu imu;
           const Status status = DecodeImu(m.data, &imu);
           if (!status.ok()) return fail(m, status);
           imus.push_back(imu);
-        } else if (type == kTfType && (topic == "/tf_static" || topic == "/tf")) {
+        } else if (type == kRosTfMessageType && (topic == "/tf_static" || topic == "/tf")) {
           std::vector<RosTransform> t;
           const Status status = DecodeTfMessage(m.data, &t);
           if (!status.ok()) return fail(m, status);
@@ -461,7 +455,7 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
 
   auto store = std::make_shared<BagFrameStore>(
       bag, spool_path, options.image_topic, options.cloud_topic,
-      summary.topics.at(options.image_topic).type == kCompressedType);
+      summary.topics.at(options.image_topic).type == kRosCompressedImageType);
   drive->drive_dir = bag;
   drive->calib_dir = bag;
   for (const auto& [cloud, image] : frames) {
@@ -473,9 +467,8 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
     store->clouds.push_back(clouds[cloud]);
     store->images.push_back(images[image]);
   }
-  STCALIB_RETURN_IF_ERROR(
-      CameraFromInfo(info, &drive->camera).WithContext(bag + ": " + info_topic + ": "));
-  STCALIB_RETURN_IF_ERROR(MakeRectifyMaps(drive->camera, &drive->rectify));
+  STCALIB_RETURN_IF_ERROR(CameraFromInfo(info, &drive->camera, &drive->rectify)
+                              .WithContext(bag + ": " + info_topic + ": "));
   store->width = drive->camera.image_width;
   store->height = drive->camera.image_height;
 
@@ -486,14 +479,17 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
                          "\" and the LiDAR frame \"" + cloud_frame +
                          "\" in /tf_static or /tf: give the start with --init_calib");
   }
-  if (!odometry.empty()) {
-    const std::string body = odometry.front().child_frame_id;
-    if (!LookUpTransform(transforms, cloud_frame, body, &drive->T_lidar_imu)) {
-      return Status::Error(bag + ": " + options.odom_topic + ": no transform between its frame \"" +
-                           body + "\" and the LiDAR frame \"" + cloud_frame +
-                           "\" in /tf_static or /tf");
+  // The odometry's (or IMU's) frame in the LiDAR's, which carries its motion to the LiDAR.
+  auto place_body = [&](const std::string& topic, const std::string& frame) -> Status {
+    if (!LookUpTransform(transforms, cloud_frame, frame, &drive->T_lidar_imu)) {
+      return Status::Error(bag + ": " + topic + ": no transform between its frame \"" + frame +
+                           "\" and the LiDAR frame \"" + cloud_frame + "\" in /tf_static or /tf");
     }
     drive->has_imu_calibration = true;
+    return Status::Ok();
+  };
+  if (!odometry.empty()) {
+    STCALIB_RETURN_IF_ERROR(place_body(options.odom_topic, odometry.front().child_frame_id));
     for (const RosOdometry& o : odometry) {
       OdometrySample s;
       s.stamp_ns = o.stamp_ns;
@@ -505,13 +501,7 @@ Status OpenBagDrive(const BagDriveOptions& options, Drive* drive) {
     }
   }
   if (!imus.empty()) {
-    const std::string imu_frame = imus.front().frame_id;
-    if (!LookUpTransform(transforms, cloud_frame, imu_frame, &drive->T_lidar_imu)) {
-      return Status::Error(bag + ": " + options.imu_topic + ": no transform between its frame \"" +
-                           imu_frame + "\" and the LiDAR frame \"" + cloud_frame +
-                           "\" in /tf_static or /tf");
-    }
-    drive->has_imu_calibration = true;
+    STCALIB_RETURN_IF_ERROR(place_body(options.imu_topic, imus.front().frame_id));
     for (const RosImu& imu : imus) {
       if (!imu.angular_velocity_rad_s.allFinite()) {
         return Status::Error(bag + ": " + options.imu_topic + " message at " +

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "core/io/drive.h"
+#include "core/io/image.h"
 #include "core/io/ros_messages.h"
 #include "core/types/status.h"
 
@@ -40,7 +41,8 @@ LidarScan ScanFromCloud(const CloudPoints& cloud, uint32_t rows);
 // The ros2msg camera: CameraInfo's R and P are KITTI's R_rect_00 and P_rect_02 (a point X in the
 // camera frame lands at P·(R·X) in the rectified image), and its K and D undistort a raw image
 // (plumb_bob, rational_polynomial, equidistant); with all-zero D the image is taken as already
-// rectified. Errors name an unsupported model or a P without focal length.
-Status CameraFromInfo(const RosCameraInfo& info, CameraCalibration* camera);
+// rectified. `maps` rectifies the raw images (empty when they are rectified). Errors name an
+// unsupported model or a P without focal length.
+Status CameraFromInfo(const RosCameraInfo& info, CameraCalibration* camera, RectifyMaps* maps);
 
 }  // namespace stcalib

@@ -142,7 +142,7 @@ Status DecodeHeader(const std::vector<uint8_t>& cdr, int64_t* stamp_ns, std::str
 }
 
 Status DecodeImage(const std::vector<uint8_t>& cdr, RosImage* image) {
-  STCALIB_RETURN_IF_ERROR(Decode(cdr, "sensor_msgs/msg/Image", image, [](Cdr* in, RosImage* m) {
+  STCALIB_RETURN_IF_ERROR(Decode(cdr, kRosImageType, image, [](Cdr* in, RosImage* m) {
     in->Header(&m->stamp_ns, &m->frame_id);
     m->height = in->Get<uint32_t>();
     m->width = in->Get<uint32_t>();
@@ -206,7 +206,7 @@ Status DecodeCompressedImage(const std::vector<uint8_t>& cdr, int64_t* stamp_ns,
   in.Header(stamp_ns, &frame_id);
   const std::string format = in.String();
   const std::vector<uint8_t> data = in.Bytes();
-  const std::string type = "sensor_msgs/msg/CompressedImage";
+  const std::string type = kRosCompressedImageType;
   if (!in.ok()) return Truncated(type);
   cv::Mat decoded;
   try {
@@ -223,7 +223,7 @@ Status DecodeCompressedImage(const std::vector<uint8_t>& cdr, int64_t* stamp_ns,
 }
 
 Status DecodeCameraInfo(const std::vector<uint8_t>& cdr, RosCameraInfo* info) {
-  return Decode(cdr, "sensor_msgs/msg/CameraInfo", info, [&](Cdr* in, RosCameraInfo* m) {
+  return Decode(cdr, kRosCameraInfoType, info, [&](Cdr* in, RosCameraInfo* m) {
     in->Header(&m->stamp_ns, &m->frame_id);
     m->height = in->Get<uint32_t>();
     m->width = in->Get<uint32_t>();
@@ -260,7 +260,7 @@ void SkipDoubles(Cdr* in, int n) {
 }  // namespace
 
 Status DecodeImu(const std::vector<uint8_t>& cdr, RosImu* imu) {
-  return Decode(cdr, "sensor_msgs/msg/Imu", imu, [](Cdr* in, RosImu* m) {
+  return Decode(cdr, kRosImuType, imu, [](Cdr* in, RosImu* m) {
     in->Header(&m->stamp_ns, &m->frame_id);
     m->orientation = GetQuaternion(in);
     SkipDoubles(in, 9);
@@ -272,7 +272,7 @@ Status DecodeImu(const std::vector<uint8_t>& cdr, RosImu* imu) {
 }
 
 Status DecodeOdometry(const std::vector<uint8_t>& cdr, RosOdometry* odometry) {
-  return Decode(cdr, "nav_msgs/msg/Odometry", odometry, [](Cdr* in, RosOdometry* m) {
+  return Decode(cdr, kRosOdometryType, odometry, [](Cdr* in, RosOdometry* m) {
     in->Header(&m->stamp_ns, &m->frame_id);
     m->child_frame_id = in->String();
     m->position_m = GetVector3(in);
@@ -285,7 +285,7 @@ Status DecodeOdometry(const std::vector<uint8_t>& cdr, RosOdometry* odometry) {
 }
 
 Status DecodePointCloud2(const std::vector<uint8_t>& cdr, RosPointCloud* cloud) {
-  return Decode(cdr, "sensor_msgs/msg/PointCloud2", cloud, [](Cdr* in, RosPointCloud* m) {
+  return Decode(cdr, kRosPointCloud2Type, cloud, [](Cdr* in, RosPointCloud* m) {
     in->Header(&m->stamp_ns, &m->frame_id);
     m->height = in->Get<uint32_t>();
     m->width = in->Get<uint32_t>();
@@ -308,7 +308,7 @@ Status DecodePointCloud2(const std::vector<uint8_t>& cdr, RosPointCloud* cloud) 
 
 Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* out) {
   *out = CloudPoints();
-  const std::string type = "sensor_msgs/msg/PointCloud2";
+  const std::string type = kRosPointCloud2Type;
   auto find = [&](const std::string& name) -> const RosPointField* {
     for (const RosPointField& f : cloud.fields) {
       if (f.name == name) return &f;
@@ -387,7 +387,7 @@ Status ExtractCloudPoints(const RosPointCloud& cloud, CloudPoints* out) {
 Status DecodeTfMessage(const std::vector<uint8_t>& cdr, std::vector<RosTransform>* transforms) {
   std::vector<Eigen::Quaterniond> rotations;
   const Status decoded =
-      Decode(cdr, "tf2_msgs/msg/TFMessage", transforms, [&](Cdr* in, std::vector<RosTransform>* m) {
+      Decode(cdr, kRosTfMessageType, transforms, [&](Cdr* in, std::vector<RosTransform>* m) {
         const uint32_t n = in->Get<uint32_t>();
         if (n > cdr.size() / 64) return in->Fail();  // each takes more than 64 bytes
         for (uint32_t k = 0; in->ok() && k < n; ++k) {
@@ -534,12 +534,12 @@ std::string Ros2MsgDefinition(const std::string& type) {
   const std::string quaternion = separator +
                                  "geometry_msgs/Quaternion\nfloat64 x 0\nfloat64 y 0\n"
                                  "float64 z 0\nfloat64 w 1";
-  if (type == "sensor_msgs/msg/Image") {
+  if (type == kRosImageType) {
     return "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\n"
            "uint8 is_bigendian\nuint32 step\nuint8[] data" +
            header;
   }
-  if (type == "sensor_msgs/msg/CameraInfo") {
+  if (type == kRosCameraInfoType) {
     return "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\n"
            "float64[] d\nfloat64[9] k\nfloat64[9] r\nfloat64[12] p\nuint32 binning_x\n"
            "uint32 binning_y\nsensor_msgs/RegionOfInterest roi" +
@@ -547,7 +547,7 @@ std::string Ros2MsgDefinition(const std::string& type) {
            "sensor_msgs/RegionOfInterest\nuint32 x_offset\nuint32 y_offset\nuint32 height\n"
            "uint32 width\nbool do_rectify";
   }
-  if (type == "sensor_msgs/msg/PointCloud2") {
+  if (type == kRosPointCloud2Type) {
     return "std_msgs/Header header\nuint32 height\nuint32 width\nsensor_msgs/PointField[] fields\n"
            "bool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense" +
            header + separator +
@@ -555,7 +555,7 @@ std::string Ros2MsgDefinition(const std::string& type) {
            "uint8 INT32=5\nuint8 UINT32=6\nuint8 FLOAT32=7\nuint8 FLOAT64=8\nstring name\n"
            "uint32 offset\nuint8 datatype\nuint32 count";
   }
-  if (type == "nav_msgs/msg/Odometry") {
+  if (type == kRosOdometryType) {
     return "std_msgs/Header header\nstring child_frame_id\n"
            "geometry_msgs/PoseWithCovariance pose\ngeometry_msgs/TwistWithCovariance twist" +
            header + separator +
@@ -570,14 +570,14 @@ std::string Ros2MsgDefinition(const std::string& type) {
            "geometry_msgs/Twist\ngeometry_msgs/Vector3 linear\ngeometry_msgs/Vector3 angular" +
            vector3;
   }
-  if (type == "sensor_msgs/msg/Imu") {
+  if (type == kRosImuType) {
     return "std_msgs/Header header\ngeometry_msgs/Quaternion orientation\n"
            "float64[9] orientation_covariance\ngeometry_msgs/Vector3 angular_velocity\n"
            "float64[9] angular_velocity_covariance\ngeometry_msgs/Vector3 linear_acceleration\n"
            "float64[9] linear_acceleration_covariance" +
            header + quaternion + vector3;
   }
-  if (type == "tf2_msgs/msg/TFMessage") {
+  if (type == kRosTfMessageType) {
     return "geometry_msgs/TransformStamped[] transforms" + separator +
            "geometry_msgs/TransformStamped\nstd_msgs/Header header\nstring child_frame_id\n"
            "geometry_msgs/Transform transform" +

@@ -17,6 +17,15 @@ namespace stcalib {
 // Only the messages and fields a calibration reads; every decoder checks every length against
 // the bytes it was given and names the message type in its errors.
 
+// The message types read and written, as bags name them.
+inline constexpr char kRosImageType[] = "sensor_msgs/msg/Image";
+inline constexpr char kRosCompressedImageType[] = "sensor_msgs/msg/CompressedImage";
+inline constexpr char kRosCameraInfoType[] = "sensor_msgs/msg/CameraInfo";
+inline constexpr char kRosPointCloud2Type[] = "sensor_msgs/msg/PointCloud2";
+inline constexpr char kRosImuType[] = "sensor_msgs/msg/Imu";
+inline constexpr char kRosOdometryType[] = "nav_msgs/msg/Odometry";
+inline constexpr char kRosTfMessageType[] = "tf2_msgs/msg/TFMessage";
+
 // The std_msgs/Header that opens a message (Image, CompressedImage, CameraInfo, PointCloud2, Imu,
 // Odometry), without reading the rest.
 Status DecodeHeader(const std::vector<uint8_t>& cdr, int64_t* stamp_ns, std::string* frame_id);
