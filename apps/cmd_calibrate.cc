@@ -111,8 +111,6 @@ CalibrateJob CalibrateJobFromFlags() {
   OnlineCalibratorOptions& o = job.online;
   o.window_frames = FLAGS_window_frames;
   o.time_offset_bound_s = FLAGS_time_offset_bound_s;
-  o.lost_grid_deg = FLAGS_lost_grid_deg;
-  o.acquire_time_offset = FLAGS_acquire_time_offset;
   o.point_margin = FLAGS_point_margin;
   ParseFolds(FLAGS_lidar_folds, &o.folds);
   o.horizontal_weight = FLAGS_horizontal_weight;
@@ -138,10 +136,10 @@ CalibrateJob CalibrateJobFromFlags() {
   CHECK(ImageOptionsFromFlags(&job.source.image).ok()) << FLAGS_detector;
   job.convergence.health_check.min_health = FLAGS_min_health;
   job.convergence.min_final_health = o.lost_health;  // lost is never converged
-  StartUncertainty uncertainty;
   // CalibrateFlagsError has checked the figures.
-  CHECK(ParseStartUncertainty(FLAGS_init_uncertainty, &uncertainty).ok()) << FLAGS_init_uncertainty;
-  o = ForStartUncertainty(o, uncertainty, job.perturb_time_s);
+  CHECK(ParseStartUncertainty(FLAGS_init_uncertainty, &o.start_uncertainty).ok())
+      << FLAGS_init_uncertainty;
+  o = WithStartUncertainty(o, job.perturb_time_s);
   return job;
 }
 
@@ -216,7 +214,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     source_options.view_margin_deg =
         std::max(source_options.view_margin_deg, job.online.search.max_rotation_offset_deg + 10.0);
   }
-  if (!job.online.ReadsCoarseLevels()) source_options.image.pyramid_basins_px.clear();
+  source_options.image.pyramid_basins_px.clear();  // the search reads the finest map only
   std::unique_ptr<DriveFrameSource> source;
   status = DriveFrameSource::Create(&drive, source_options, &source);
   if (!status.ok()) return ReportError(kCommand, status);
@@ -451,7 +449,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   if (!status.ok()) return fail(status);
 
   std::string csv =
-      "frame,accepted,coarse_search,points,gray_rate,health,roll_deg,pitch_deg,yaw_deg,x_m,y_m,z_m,"
+      "frame,accepted,from_hypotheses,points,gray_rate,health,roll_deg,pitch_deg,yaw_deg,x_m,y_m,z_m,"
       "time_offset_s,rotation_error_deg,translation_error_m,time_offset_error_s,search_ms,refine_"
       "ms,phase,reason\n";
   std::vector<double> xs, rot_err, trans_err_cm, dt_ms, roll_e, pitch_e, yaw_e;
@@ -462,7 +460,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     std::snprintf(
         row, sizeof(row),
         "%d,%d,%d,%d,%.4f,%.4f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.6f,%.5f,%.5f,%.6f,%.2f,%.2f,",
-        r.frame, r.accepted, r.coarse_search, r.points, r.gray_rate_after, r.health, rpy.x(),
+        r.frame, r.accepted, r.from_hypotheses, r.points, r.gray_rate_after, r.health, rpy.x(),
         rpy.y(), rpy.z(), r.after.T_camera_lidar.translation().x(),
         r.after.T_camera_lidar.translation().y(), r.after.T_camera_lidar.translation().z(),
         r.after.time_offset_s, e.rotation_deg, e.translation_norm_m, e.time_offset_s, r.search_ms,
@@ -554,6 +552,12 @@ std::string CalibrateFlagsError() {
   StartUncertainty uncertainty;
   const Status uncertainty_status = ParseStartUncertainty(FLAGS_init_uncertainty, &uncertainty);
   if (!uncertainty_status.ok()) return uncertainty_status.message();
+  const size_t hypotheses = HypothesisLattice::CountFor(uncertainty, LatticeSteps());
+  if (hypotheses > HypothesisLattice::kMaxHypotheses) {
+    return "--init_uncertainty=" + FLAGS_init_uncertainty + ": a lattice of " +
+           std::to_string(hypotheses) + " hypotheses does not fit in memory (at most " +
+           std::to_string(HypothesisLattice::kMaxHypotheses) + "): narrow the start uncertainty";
+  }
   OnlineCalibratorOptions::Folds folds;
   if (!ParseFolds(FLAGS_lidar_folds, &folds)) {
     return "--lidar_folds must be " + FoldsChoices();

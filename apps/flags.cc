@@ -67,10 +67,6 @@ DEFINE_double(
     perturb_time_s, 0.0,
     "calibrate: initial time offset δ0 [s]; check: added to the stored δ (time_offset.txt "
     "beside the checked calib_velo_to_cam.txt, else 0)");
-DEFINE_string(init_uncertainty, "",
-              "calibrate: how far off the start may be on each axis, ROT_DEG,TRANS_M,TIME_S "
-              "(e.g. 5,0.2,0.1): widens the acquisition grid, the bounds and the translation and "
-              "time offset priors to match (empty: the defaults, for about 3 deg, 5 cm, 30 ms)");
 DEFINE_int32(first_frame, 0, "calibrate: first frame used");
 DEFINE_int32(num_frames, 0, "calibrate: frames used (0 = to the end)");
 // Defaults of the tuning flags come from the library's option structs, where the reasons for
@@ -80,6 +76,10 @@ const stcalib::OnlineCalibratorOptions kOnline;
 const stcalib::FrameSourceOptions kSource;
 const stcalib::ConvergenceOptions kConvergence;
 }  // namespace
+DEFINE_string(init_uncertainty, StartUncertaintyText(kOnline.start_uncertainty).c_str(),
+              "calibrate: how far off the start may be on each axis, ROT_DEG,TRANS_M,TIME_S "
+              "(positive): the acquisition's hypothesis lattice spans it, and the bounds and the "
+              "translation and time offset priors hold it");
 DEFINE_int32(window_frames, kOnline.window_frames,
              "calibrate: sliding window of frames searched and refined together");
 DEFINE_double(time_offset_bound_s, kOnline.time_offset_bound_s, "calibrate: |δ| bound [s]");
@@ -126,10 +126,6 @@ DEFINE_double(lidar_delay_s, 0.1, "eval-temporal: the kept sweeps arrive this la
 DEFINE_double(eval_max_range_m, 120.0, "eval-temporal: points beyond this range are left out [m]");
 DEFINE_bool(polish, true,
             "calibrate: refine the final estimate over the refinement's frames from itself");
-DEFINE_double(lost_grid_deg, kOnline.lost_grid_deg,
-              "calibrate: when lost, first an exhaustive rotation grid of +-this [deg] (0 = none)");
-DEFINE_bool(acquire_time_offset, kOnline.acquire_time_offset,
-            "calibrate: while acquiring, scan δ over its whole bound after the rotation grid");
 DEFINE_bool(bandpass_score, kSource.bandpass_score,
             "calibrate: with --suppress_texture, score on the band-pass IDT (not clipped at 0)");
 DEFINE_string(

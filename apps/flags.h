@@ -59,8 +59,6 @@ DECLARE_int32(lidar_decimation);
 DECLARE_double(lidar_delay_s);
 DECLARE_double(eval_max_range_m);
 DECLARE_bool(polish);
-DECLARE_double(lost_grid_deg);
-DECLARE_bool(acquire_time_offset);
 DECLARE_bool(bandpass_score);
 DECLARE_double(point_margin);
 DECLARE_string(lidar_folds);

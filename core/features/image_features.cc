@@ -178,6 +178,21 @@ cv::Mat SuppressTexture(const cv::Mat& idt, double sigma_px) {
   return out;
 }
 
+cv::Mat CoarseScoreMap(const cv::Mat& distance_raw_px, double basin_px, int scale) {
+  CHECK_GT(scale, 0);
+  CHECK(basin_px > 0);
+  cv::Mat distance, idt, blurred, padded;
+  cv::resize(distance_raw_px, distance, cv::Size(distance_raw_px.cols / scale,
+                                                 distance_raw_px.rows / scale),
+             0, 0, cv::INTER_AREA);
+  cv::min(distance, basin_px, distance);
+  distance.convertTo(idt, CV_32F, -255.0 / basin_px, 255.0);
+  const double sigma = basin_px / scale;
+  cv::GaussianBlur(idt, blurred, cv::Size(), sigma, sigma, cv::BORDER_REPLICATE);
+  cv::copyMakeBorder(idt - blurred, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  return padded;
+}
+
 ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptions& options) {
   CHECK(options.Validate().ok()) << options.Validate().message();
   ImageFeatures features;

@@ -112,4 +112,10 @@ cv::Mat BandPass(const cv::Mat& idt, double sigma_px);
 // max(0, BandPass(idt, sigma_px)).
 cv::Mat SuppressTexture(const cv::Mat& idt, double sigma_px);
 
+// The acquisition's coarse score map (docs/method.md §7): the raw distance map averaged over
+// `scale`×`scale` cells, its IDT (basin `basin_px`, full-size pixels) minus its blur at
+// σ = `basin_px` (a band-pass: dense texture averages to zero, an isolated edge is a wide peak),
+// padded by one zero cell on each side. CV_32F, (cols/scale + 2)×(rows/scale + 2).
+cv::Mat CoarseScoreMap(const cv::Mat& distance_raw_px, double basin_px, int scale);
+
 }  // namespace stcalib

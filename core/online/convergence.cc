@@ -47,12 +47,6 @@ TranslationMove TranslationMoveBeyondPrior(const CalibrationState& initial,
 
 namespace {
 
-// A still-acquiring run may claim when its last rotation grid agreed with the estimate over
-// every frame the run used, and over at least this many: one frame's optimum scatters by about
-// 1° (docs/method.md §10), a few frames' side peaks lie 3-4° off, and ten frames of a structured
-// street settle within 0.3°.
-constexpr int kMinAgreementFrames = 8;
-
 // Frames that share sweeps through their local maps: 1 + the oldest sweep any point of `frames`
 // comes from (CalibrationFrame::sweep_ages; 1 without ages). The jackknife leaves out blocks of
 // this many frames, so that a block's sweeps are not all still in the frames it keeps.
@@ -105,21 +99,18 @@ RuleOutcome EnoughFrames(const ConvergenceEvidence& e, const ConvergenceOptions&
               std::to_string(o.min_frames) + " needed)"};
 }
 
-RuleOutcome Acquired(const ConvergenceEvidence& e, const ConvergenceOptions&) {
-  if (!e.acquiring) return {"acquired", true, "acquisition ended"};
-  const int needed = std::max(kMinAgreementFrames, std::min(e.used_frames, e.acquisition_frames));
-  if (e.grid_agreement_frames >= needed) {
-    return {"acquired", true,
-            "the rotation grid agreed with the estimate on all " +
-                std::to_string(e.grid_agreement_frames) + " frames"};
+RuleOutcome OneHypothesisDominates(const ConvergenceEvidence& e, const ConvergenceOptions&) {
+  const std::string name = kDominanceRule;
+  if (!e.acquiring) {
+    return {name, true,
+            "acquisition ended: one hypothesis dominated" +
+                (e.dominance.detail.empty() ? std::string() : " (" + e.dominance.detail + ")")};
   }
-  return {"acquired", false,
-          "still acquiring (the rotation grid around the initial calibration has not yet agreed "
-          "with the estimate on a window of " +
-              std::to_string(needed) + " frames" +
-              (e.grid_agreement_frames > 0 ? ", only on " + std::to_string(e.grid_agreement_frames)
-                                           : std::string()) +
-              ")"};
+  const std::string rivals = DescribeRivals(e.dominance);
+  return {name, false,
+          "still acquiring: no hypothesis dominates the others (" +
+              (e.dominance.detail.empty() ? std::string("none compared yet") : e.dominance.detail) +
+              (rivals.empty() ? std::string() : "; runners-up: " + rivals) + ")"};
 }
 
 RuleOutcome InsideBounds(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
@@ -261,7 +252,7 @@ constexpr Rule kRules[] = {FramesUsed,
                            Features,
                            Updated,
                            EnoughFrames,
-                           Acquired,
+                           OneHypothesisDominates,
                            InsideBounds,
                            Observable,
                            RotationProfiles,
@@ -384,8 +375,7 @@ ConvergenceEvidence GatherEvidence(const OnlineCalibrator& calibrator,
   e.last_reason = last.reason;
   e.window_frames = calibrator.options().window_frames;
   e.acquiring = calibrator.acquiring();
-  e.acquisition_frames = online.refine_frames;
-  e.grid_agreement_frames = last_update.grid_agreement_frames;
+  e.dominance = calibrator.acquisition().dominance();
   e.rotation_bound_deg = online.search.max_rotation_offset_deg;
   e.time_offset_estimated = online.refine.estimate_time_offset;
   e.time_offset_s = verdict->estimate.time_offset_s;
@@ -430,7 +420,7 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
     std::vector<const CalibrationFrame*> frames;
     for (const auto& frame : recent) frames.push_back(frame.get());
     evidence.rotation_jackknife = JackknifeRotation(frames, verdict.estimate, initial,
-                                                    calibrator.RefineOptionsInUse(/*polish=*/true),
+                                                    calibrator.RefineOptionsInUse(),
                                                     verdict.shared_sweep_frames);
     verdict.rotation_jackknife = *evidence.rotation_jackknife;
     judgement = Judge(evidence, options);

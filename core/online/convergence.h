@@ -68,11 +68,10 @@ struct ConvergenceEvidence {
   int updates = 0;           ///< frames that ran the search and refinement
   std::string last_reason;   ///< the last used frame's reason
   int window_frames = 0;     ///< the search window's length [frames]
-  // Acquisition: still acquiring at the end, the frames a full acquisition window holds, and
-  // the frames of the last update's rotation grid when it agreed with the estimate (0: it did not).
+  // Acquisition: still acquiring at the end, and the hypotheses' dominance as of the last update
+  // that compared them.
   bool acquiring = false;
-  int acquisition_frames = 0;
-  int grid_agreement_frames = 0;
+  Dominance dominance;
   double rotation_moved_deg = 0;  ///< the estimate's rotation from the start [deg]
   double rotation_bound_deg = 0;  ///< the search's rotation bound around the start [deg]
   bool time_offset_estimated = true;
@@ -118,6 +117,7 @@ Judgement Judge(const ConvergenceEvidence& evidence, const ConvergenceOptions& o
 // The rules whose evidence is measured only when the rules before them pass (Judge fails each
 // while it is not measured).
 inline constexpr const char* kJackknifeRule = "rotation_jackknife";
+inline constexpr const char* kDominanceRule = "one_hypothesis_dominates";
 inline constexpr const char* kSuppressedCheckRule = "suppressed_maps_check";
 
 struct ConvergenceVerdict {

@@ -10,6 +10,13 @@ namespace stcalib {
 
 namespace {
 
+// The acquisition's coarse maps (CoarseScoreMap): a basin wide enough that a hypothesis half a
+// lattice step from the truth still reads its peak, at a quarter of the image size (a map of
+// ~120 KB on KITTI stays in the cache while the lattice reads it).
+// Measured: docs/tuning.md#lattice-steps
+constexpr double kCoarseBasinPx = 20;
+constexpr int kCoarseMapScale = 4;
+
 // A frame stays in the calibrator's window for up to refine_frames frames, and every full-size
 // float map costs width × height × 4 bytes (1.9 MB on KITTI). Of its image features the frame's
 // readers need only what it does not hold itself: the edge count (ImageFeatures::empty); the
@@ -136,6 +143,17 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
     out->distance_cap_px = std::max(out->distance_cap_px, max_value);
   }
 
+  // The acquisition's coarse maps, from the raw distances (released below).
+  if (!out->image.empty()) {
+    const bool oriented = options_.oriented_maps;
+    for (int kind = 0; kind < 2; ++kind) {
+      const cv::Mat& raw = !oriented    ? out->image.distance_raw_px
+                           : kind == 0 ? out->image.distance_vertical_raw_px
+                                       : out->image.distance_horizontal_raw_px;
+      out->coarse_map[kind] = CoarseScoreMap(raw, kCoarseBasinPx, kCoarseMapScale);
+    }
+    out->coarse_map_scale = kCoarseMapScale;
+  }
   out->score_maps_bandpass = options_.suppress_texture && options_.bandpass_score;
   ReleaseMapsNotRead(options_.ImageOptions().basin_px, out);
 

@@ -17,6 +17,11 @@
 namespace stcalib {
 namespace {
 
+// The span of a lost estimate's lattice (at most the start's): a disturbance, not a new start.
+// Wider, on the shared drive the fine score's side peaks 4-5° away outscore the estimate's over a
+// fold-free window (docs/tuning.md#lost-span).
+constexpr StartUncertainty kLostSpan{3.0, 0.05, 0.02};
+
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -40,18 +45,9 @@ CalibrationState KeepObservableAxes(const CalibrationState& old, const Calibrati
 
 Status OnlineCalibratorOptions::Validate() const {
   if (window_frames < 1) return Status::Error("online: window_frames must be >= 1");
-  if (!(polish_forward_std_m >= 0)) {
-    return Status::Error("online: polish_forward_std_m must be >= 0");
-  }
-  if (!(acquired_loss_scale_px > 0)) {
-    return Status::Error("online: acquired_loss_scale_px must be > 0");
-  }
+  if (refine_frames < 1) return Status::Error("online: refine_frames must be >= 1");
   if (!(refined_score_tolerance >= 0 && refined_score_tolerance < 1)) {
     return Status::Error("online: refined_score_tolerance must be in [0, 1)");
-  }
-  if (refine_map_sweeps < 0) return Status::Error("online: refine_map_sweeps must be >= 0");
-  if (!(wide_grid_deg >= 0) || wide_grid_agreement_frames < 1) {
-    return Status::Error("online: wide_grid_deg must be >= 0 and wide_grid_agreement_frames >= 1");
   }
   if (!(tracking_max_lag_deg >= 0)) {
     return Status::Error("online: tracking_max_lag_deg must be >= 0");
@@ -59,10 +55,12 @@ Status OnlineCalibratorOptions::Validate() const {
   if (tracking_update_every < 1) {
     return Status::Error("online: tracking_update_every must be >= 1");
   }
-  if (!(horizontal_weight >= 0 && horizontal_weight <= 1) ||
-      !(tracking_horizontal_weight >= 0 && tracking_horizontal_weight <= 1)) {
-    return Status::Error(
-        "online: horizontal_weight and tracking_horizontal_weight must be in [0, 1]");
+  if (!(horizontal_weight >= 0 && horizontal_weight <= 1)) {
+    return Status::Error("online: horizontal_weight must be in [0, 1]");
+  }
+  if (!(start_uncertainty.rotation_deg > 0 && start_uncertainty.translation_m > 0 &&
+        start_uncertainty.time_offset_s > 0)) {
+    return Status::Error("online: every start_uncertainty figure must be > 0");
   }
   STCALIB_RETURN_IF_ERROR(search.Validate());
   return refine.Validate();
@@ -89,10 +87,9 @@ Phase NextPhase(Phase current, const PhaseInputs& in) {
   switch (current) {
     case Phase::kFilling:
       if (in.window_size < in.window_frames) return Phase::kFilling;
-      if (!in.acquisition) return acquired;
-      return in.grid_agreed ? acquired : Phase::kAcquiring;
+      return in.dominant ? acquired : Phase::kAcquiring;
     case Phase::kAcquiring:
-      return in.grid_agreed ? acquired : Phase::kAcquiring;
+      return in.dominant ? acquired : Phase::kAcquiring;
     case Phase::kTracking:
     case Phase::kLost:
       return acquired;
@@ -124,96 +121,60 @@ OnlineCalibratorOptions WithSharedSettings(const OnlineCalibratorOptions& option
   return out;
 }
 
-Status ParseStartUncertainty(const std::string& text, StartUncertainty* uncertainty) {
-  *uncertainty = StartUncertainty();
-  if (text.empty()) return Status::Ok();
-  const std::string what = "--init_uncertainty=" + text + ": ";
-  std::vector<double> figures;
-  size_t begin = 0;
-  while (begin <= text.size()) {
-    const size_t end = std::min(text.find(',', begin), text.size());
-    const std::string field = text.substr(begin, end - begin);
-    char* stop = nullptr;
-    const double value = std::strtod(field.c_str(), &stop);
-    if (field.empty() || stop != field.c_str() + field.size() || !std::isfinite(value) ||
-        value < 0) {
-      return Status::Error(what + "\"" + field +
-                           "\" is not a non-negative number (expected ROT_DEG,TRANS_M,TIME_S)");
-    }
-    figures.push_back(value);
-    begin = end + 1;
-  }
-  if (figures.size() != 3) {
-    return Status::Error(what + "expected three figures ROT_DEG,TRANS_M,TIME_S, got " +
-                         std::to_string(figures.size()));
-  }
-  uncertainty->rotation_deg = figures[0];
-  uncertainty->translation_m = figures[1];
-  uncertainty->time_offset_s = figures[2];
-  return Status::Ok();
-}
-
-OnlineCalibratorOptions ForStartUncertainty(const OnlineCalibratorOptions& options,
-                                            const StartUncertainty& uncertainty,
-                                            double initial_time_offset_s) {
+OnlineCalibratorOptions WithStartUncertainty(const OnlineCalibratorOptions& options,
+                                             double initial_time_offset_s) {
   OnlineCalibratorOptions out = options;
-  const double rotation_deg = std::max(0.0, uncertainty.rotation_deg);
-  const double translation_m = std::max(0.0, uncertainty.translation_m);
-  const double time_s = std::max(0.0, uncertainty.time_offset_s);
+  const StartUncertainty& u = options.start_uncertainty;
+  // The bounds are norms over the three axes; the lattice reaches half a step past its span.
   constexpr double kBasinDeg = 1.0;  // the band-pass score's peak, docs/method.md §10
-  if (out.lost_grid_deg > 0 && rotation_deg + kBasinDeg > out.lost_grid_deg) {
-    out.wide_grid_deg = std::max(out.wide_grid_deg, rotation_deg + kBasinDeg);
-  }
-  if (out.wide_grid_deg > 0 && time_s > out.refine.prior_sigma_time_s) {
-    out.wide_time_offset_s = time_s;
-  }
-  // The bounds are norms over the three axes.
   const double kAxes = std::sqrt(3.0);
+  const LatticeSteps steps;
   out.search.max_rotation_offset_deg =
-      std::max(out.search.max_rotation_offset_deg, kAxes * rotation_deg + kBasinDeg);
+      std::max(out.search.max_rotation_offset_deg, kAxes * u.rotation_deg + kBasinDeg);
   out.search.max_translation_offset_m =
-      std::max(out.search.max_translation_offset_m, kAxes * translation_m + 0.05);
-  out.search.translation_prior_sigma_m =
-      std::max(out.search.translation_prior_sigma_m, translation_m);
-  out.refine.prior_sigma_translation_m =
-      std::max(out.refine.prior_sigma_translation_m, translation_m);
-  out.search.time_offset_prior_sigma_s = std::max(out.search.time_offset_prior_sigma_s, time_s);
-  out.refine.prior_sigma_time_s = std::max(out.refine.prior_sigma_time_s, time_s);
-  out.time_offset_bound_s =
-      std::max(out.time_offset_bound_s, std::abs(initial_time_offset_s) + time_s);
+      std::max(out.search.max_translation_offset_m, kAxes * (u.translation_m + steps.translation_m.maxCoeff() / 2));
+  out.search.translation_prior_sigma_m = std::max(out.search.translation_prior_sigma_m, u.translation_m);
+  out.refine.prior_sigma_translation_m = std::max(out.refine.prior_sigma_translation_m, u.translation_m);
+  out.search.time_offset_prior_sigma_s = std::max(out.search.time_offset_prior_sigma_s, u.time_offset_s);
+  out.refine.prior_sigma_time_s = std::max(out.refine.prior_sigma_time_s, u.time_offset_s);
+  out.time_offset_bound_s = std::max(out.time_offset_bound_s, std::abs(initial_time_offset_s) +
+                                                                   u.time_offset_s +
+                                                                   steps.time_offset_s / 2);
   return out;
 }
 
 OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
                                    const CalibrationState& initial)
-    : options_(WithSharedSettings(options)), state_(initial) {
+    : options_(WithSharedSettings(options)),
+      state_(initial),
+      acquisition_(options.refine_frames) {
   CHECK(options_.Validate().ok()) << options_.Validate().message();
   state_.time_offset_s =
       std::clamp(state_.time_offset_s, -options_.time_offset_bound_s, options_.time_offset_bound_s);
   anchor_ = state_;
-  grid_center_rotation_ = state_.T_camera_lidar.linear();
-  grid_narrowed_ = !(options_.wide_grid_deg > options_.lost_grid_deg);
   frames_since_update_ = options_.tracking_update_every;
   OnlineCalibratorOptions fold_free = options_;
-  fold_free.horizontal_weight = options_.tracking_horizontal_weight;
+  fold_free.horizontal_weight = kFoldFreeHorizontalWeight;
   fold_free_options_ = WithSharedSettings(fold_free);
+  // The lattice around the start; too large a lattice is a usage error the CLI reports first.
+  const Status centred =
+      acquisition_.Centre(state_, {}, options_.horizontal_weight, options_.start_uncertainty);
+  CHECK(centred.ok()) << centred.message();
 }
 
-const std::shared_ptr<const CalibrationFrame>& OnlineCalibrator::InUse(const WindowFrame& frame,
-                                                                       bool refine) const {
+const std::shared_ptr<const CalibrationFrame>& OnlineCalibrator::InUse(
+    const WindowFrame& frame) const {
   const bool drop = options_.folds == OnlineCalibratorOptions::Folds::kDrop || folds_dropped_;
-  if (refine) return drop ? frame.refine_without_folds : frame.refine_all;
   return drop ? frame.without_folds : frame.all;
 }
 
-std::vector<const CalibrationFrame*> OnlineCalibrator::LatestFrames(int count, bool with_folds,
-                                                                    bool refine) const {
+std::vector<const CalibrationFrame*> OnlineCalibrator::LatestFrames(int count,
+                                                                    bool with_folds) const {
   std::vector<const CalibrationFrame*> frames;
   const size_t n = std::min<size_t>(window_.size(), count);
   for (size_t k = window_.size() - n; k < window_.size(); ++k) {
     const WindowFrame& frame = window_[k];
-    frames.push_back(with_folds ? (refine ? frame.refine_all : frame.all).get()
-                                : InUse(frame, refine).get());
+    frames.push_back(with_folds ? frame.all.get() : InUse(frame).get());
   }
   return frames;
 }
@@ -254,7 +215,15 @@ FrameReport OnlineCalibrator::SkipFrame(int frame, const std::string& why) const
 }
 
 std::vector<const CalibrationFrame*> OnlineCalibrator::RefineWindow() const {
-  return LatestFrames(options_.refine_frames, /*with_folds=*/false, /*refine=*/true);
+  return LatestFrames(options_.refine_frames);
+}
+
+int OnlineCalibrator::SharedSweepFrames() const {
+  int oldest = 0;
+  for (const WindowFrame& frame : window_) {
+    for (uint8_t age : frame.all->sweep_ages) oldest = std::max<int>(oldest, age);
+  }
+  return 1 + oldest;
 }
 
 std::string OnlineCalibrator::RefusalReason(const CalibrationFrame& frame) const {
@@ -302,23 +271,29 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   UpdatePhase(window_size, report.health_before);
   const std::string wait = WhyNoUpdate(window_size, update_now || refit, report.health_before);
   if (!wait.empty()) return KeepEstimate(report, wait);
-  // The paper's update: search (grid and δ scan first while acquiring or lost), refine, choose.
+  // The paper's update: search (from the best hypothesis while acquiring or lost), refine, choose.
   Update(&scorer, refit, &report);
   MeasureEstimate(&scorer, health_scorer, report.accepted, &report);
   RememberIfHealthy(report.health, window_size);
-  UpdatePhase(window_size, report.health);
+  // The acquisition ends when one hypothesis dominates and the estimate sits on its peak.
+  const std::vector<Hypothesis>& hypotheses = acquisition_.hypotheses();
+  const bool dominant =
+      report.from_hypotheses && acquisition_.dominance().dominant && !hypotheses.empty() &&
+      RotationErrorDeg(hypotheses.front().state.T_camera_lidar.linear(),
+                       state_.T_camera_lidar.linear()) < DominanceOptions().merge_deg;
+  UpdatePhase(window_size, report.health, dominant);
   report.phase = phase_;
   return report;
 }
 
 bool OnlineCalibrator::DropFoldsOnceAcquired() {
   // From the first frame after the acquisition (its last update and a polish right after it read
-  // the frames the estimate was acquired on). Without the grid's acquisition there is none to
-  // end, and the folds stay. Once dropped they stay out, of a lost estimate's grid too. The
-  // first frame without them that updates does so at once and by a full step (the refit): the
-  // estimate was acquired with the folds, and its translation carries their bias.
-  if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && Acquires() &&
-      !acquiring() && !folds_dropped_) {
+  // the frames the estimate was acquired on). Once dropped they stay out, of a lost estimate's
+  // lattice too. The first frame without them that updates does so at once and by a full step
+  // (the refit): the estimate was acquired with the folds, and its translation carries their
+  // bias.
+  if (options_.folds == OnlineCalibratorOptions::Folds::kDropWhenTracking && !acquiring() &&
+      !folds_dropped_) {
     folds_dropped_ = true;
     refit_pending_ = true;
   }
@@ -331,21 +306,19 @@ void OnlineCalibrator::AdmitToWindow(const CalibrationFrame& frame) {
   in_window.without_folds = options_.folds == OnlineCalibratorOptions::Folds::kKeep
                                 ? in_window.all
                                 : WithoutFolds(in_window.all);
-  in_window.refine_all = LatestSweepsOnly(in_window.all, options_.refine_map_sweeps);
-  // With Folds::kKeep both are one frame: restrict it once.
-  in_window.refine_without_folds =
-      in_window.without_folds == in_window.all
-          ? in_window.refine_all
-          : LatestSweepsOnly(in_window.without_folds, options_.refine_map_sweeps);
   window_.push_back(std::move(in_window));
   while (static_cast<int>(window_.size()) >
          std::max(options_.window_frames, options_.refine_frames)) {
     window_.pop_front();
   }
+  // The lattice scores the frame once, while the estimate is not (or no longer) acquired.
+  if (phase_ != Phase::kTracking) {
+    acquisition_.AddFrame(*InUse(window_.back()), ScoreOptionsInUse().horizontal_weight);
+  }
 }
 
 std::string OnlineCalibrator::WhyNoUpdate(int window_size, bool update_now, double health_before) {
-  if (options_.wait_for_full_window && phase_ == Phase::kFilling) {
+  if (phase_ == Phase::kFilling) {
     return "window filling (" + std::to_string(window_size) + " of " +
            std::to_string(options_.window_frames) + " frames): estimate kept";
   }
@@ -361,34 +334,45 @@ std::string OnlineCalibrator::WhyNoUpdate(int window_size, bool update_now, doub
 }
 
 void OnlineCalibrator::Update(WindowScorer* scorer, bool full_step, FrameReport* report) {
-  // Coarse-to-fine from the widest map when lost or while the window fills, else the finest map.
-  report->coarse_search = report->health_before < options_.lost_health ||
-                          (options_.coarse_until_window_full &&
-                           static_cast<int>(scorer->num_frames()) < options_.window_frames);
-  // The refinement's frames, every point of their maps: the grid's window and the judge of the
-  // candidates.
+  // From the lattice's hypotheses while acquiring or lost (or when the estimate's health says it
+  // is lost now), else from the estimate.
+  report->from_hypotheses = phase_ == Phase::kAcquiring || phase_ == Phase::kLost ||
+                            report->health_before < options_.lost_health;
+  // The refinement's frames, every point of their maps: the hypotheses' and candidates' judge.
   WindowScorer long_scorer(LatestFrames(options_.refine_frames), ScoreOptionsInUse());
   AdaptiveGridSearchOptions search_options = options_.search;
-  Search(scorer, &long_scorer, &search_options, report);
+  search_options.first_level = scorer->num_levels() - 1;
+  Search(scorer, &long_scorer, search_options, report);
   const auto start = std::chrono::steady_clock::now();
   report->refine = Refine(RefineWindow(), report->search.state, report->search.state, anchor_,
                           RefineOptionsInUse());
   report->refine_ms = MillisecondsSince(start);
-  Choose(Candidates(scorer, search_options, report), &long_scorer, search_options, full_step,
-         report);
+  Choose(Candidates(report), &long_scorer, search_options, full_step, report);
   refit_pending_ = false;
   state_ = report->after;
 }
 
-void OnlineCalibrator::UpdatePhase(int window_size, double health, bool grid_agreed) {
+void OnlineCalibrator::UpdatePhase(int window_size, double health, bool dominant) {
   PhaseInputs in;
   in.window_size = window_size;
   in.window_frames = options_.window_frames;
-  in.acquisition = Acquires();
-  in.grid_agreed = grid_agreed;
+  in.dominant = dominant;
   in.health = health;
   in.lost_health = options_.lost_health;
+  const Phase before = phase_;
   phase_ = NextPhase(phase_, in);
+  if (phase_ == Phase::kLost && before != Phase::kLost) {
+    // Re-acquire around the last healthy estimate: the lattice, over a disturbance's span (a lost
+    // estimate was good a moment ago), scores the window's frames anew.
+    const StartUncertainty& start = options_.start_uncertainty;
+    const StartUncertainty span{std::min(start.rotation_deg, kLostSpan.rotation_deg),
+                                std::min(start.translation_m, kLostSpan.translation_m),
+                                std::min(start.time_offset_s, kLostSpan.time_offset_s)};
+    const Status centred = acquisition_.Centre(has_last_healthy_ ? last_healthy_ : state_,
+                                               LatestFrames(options_.refine_frames),
+                                               ScoreOptionsInUse().horizontal_weight, span);
+    CHECK(centred.ok()) << centred.message();
+  }
 }
 
 FrameReport OnlineCalibrator::Polish() {
@@ -404,7 +388,7 @@ FrameReport OnlineCalibrator::Polish() {
   }
   const auto start = std::chrono::steady_clock::now();
   // Rotation, δ and the translation along the direction of travel (see the header).
-  RefineOptions refine_options = RefineOptionsInUse(/*polish=*/true);
+  RefineOptions refine_options = RefineOptionsInUse();
   refine_options.translation = RefineOptions::Translation::kAlongTravel;
   refine_options.place_at_time_offset = true;
   report.refine = Refine(frames, state_, state_, anchor_, refine_options);
@@ -414,7 +398,7 @@ FrameReport OnlineCalibrator::Polish() {
   // forward translation moves alone when its std allows.)
   const RefineResult pair = report.refine;
   const bool pair_observable = pair.usable && pair.covariance_ok &&
-                               pair.forward_std_m < options_.polish_forward_std_m &&
+                               pair.forward_std_m < kPolishForwardStdM &&
                                (!refine_options.estimate_time_offset || pair.observable[6]);
   if (!pair_observable) {
     refine_options.translation = RefineOptions::Translation::kHeld;
@@ -504,108 +488,43 @@ void OnlineCalibrator::MeasureEstimate(WindowScorer* scorer, WindowScorer* healt
   last_health_ = report->health;
 }
 
-RotationGridResult OnlineCalibrator::AcquisitionGrid(
-    WindowScorer* long_scorer, const CalibrationState& centre,
-    const AdaptiveGridSearchOptions& search_options, bool wide) {
-  if (!wide || !(options_.wide_time_offset_s > 0)) {
-    return RotationGridSearch(long_scorer, centre, anchor_, search_options,
-                              wide ? options_.wide_grid_deg : options_.lost_grid_deg,
-                              options_.lost_grid_step_deg, -1, &grid_cache_);
-  }
-  // A δ0 far off moves the near points' bearings by degrees (8 m/s × 0.1 s is 0.8 m): the wide
-  // grid runs at the estimate's δ and at five δ across the start's uncertainty around δ0, and the
-  // best (rotation, δ) wins. Its per-frame scores are not kept (the translation moves between
-  // frames): measured, docs/results.md#wide-start.
-  std::vector<double> offsets = {centre.time_offset_s};
-  for (int k = -2; k <= 2; ++k) {
-    offsets.push_back(std::clamp(anchor_.time_offset_s + k * options_.wide_time_offset_s / 2,
-                                 -options_.time_offset_bound_s, options_.time_offset_bound_s));
-  }
-  RotationGridResult best;
-  int evaluations = 0;
-  for (size_t k = 0; k < offsets.size(); ++k) {
-    CalibrationState at_offset = centre;
-    at_offset.time_offset_s = offsets[k];
-    const RotationGridResult grid =
-        RotationGridSearch(long_scorer, at_offset, anchor_, search_options, options_.wide_grid_deg,
-                           options_.lost_grid_step_deg, -1, nullptr);
-    evaluations += grid.evaluations;
-    if (k == 0 || grid.score > best.score) best = grid;
-  }
-  best.evaluations = evaluations;
-  return best;
-}
-
 void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
-                              AdaptiveGridSearchOptions* search_options, FrameReport* report) {
+                              const AdaptiveGridSearchOptions& search_options,
+                              FrameReport* report) {
   const auto start = std::chrono::steady_clock::now();
-  search_options->first_level = report->coarse_search ? 0 : scorer->num_levels() - 1;
   CalibrationState search_start = state_;
-  int grid_evaluations = 0;
-  const bool was_acquiring = acquiring();
-  bool grid_agrees = false;
-  if ((report->coarse_search || was_acquiring) && options_.lost_grid_deg > 0) {
-    // Rotations around the initial calibration's (the truth lies within the start's error of
-    // it, whatever side peak the estimate may have climbed since) or the wide stage's result,
-    // with the estimate's translation and δ (a stale δ or translation would shift the grid's
-    // best rotation).
-    CalibrationState centre = state_;
-    centre.T_camera_lidar.linear() = grid_center_rotation_;
-    const bool wide = !grid_narrowed_;
-    const RotationGridResult grid = AcquisitionGrid(long_scorer, centre, *search_options, wide);
-    grid_evaluations = grid.evaluations;
-    // Agreement: the estimate is within one lattice step (diagonals included) of the grid's
-    // best point, i.e. on the same peak.
-    const double grid_offset_deg =
-        RotationErrorDeg(grid.state.T_camera_lidar.linear(), state_.T_camera_lidar.linear());
-    grid_agrees = grid_offset_deg < std::sqrt(3.0) * options_.lost_grid_step_deg + 1e-6;
-    VLOG(1) << "frame " << report->frame << ": " << (wide ? "wide " : "") << "rotation grid best "
-            << grid_offset_deg << " deg from the estimate over " << long_scorer->num_frames()
-            << " frames";
-    if (wide && grid_agrees &&
-        static_cast<int>(long_scorer->num_frames()) >= options_.wide_grid_agreement_frames) {
-      grid_narrowed_ = true;
-      grid_center_rotation_ = grid.state.T_camera_lidar.linear();
-      grid_agrees = false;  // the narrow grid's agreement ends an acquisition, not the wide one's
+  int evaluations = 0;
+  if (report->from_hypotheses) {
+    // The lattice's best peaks, refined on the fine maps and compared frame by frame on the
+    // refinement's frames; the search starts from the best.
+    const std::vector<Hypothesis>& hypotheses = acquisition_.Update(
+        scorer, long_scorer, anchor_, search_options, SharedSweepFrames(), &evaluations);
+    // On the estimate's own peak the search refines the estimate; elsewhere it starts afresh
+    // from the best hypothesis: while acquiring, the estimate follows the best; once acquired (a
+    // lost estimate), it leaves the last healthy estimate's peak only for a hypothesis that
+    // dominates the others.
+    const bool acquired = phase_ == Phase::kTracking || phase_ == Phase::kLost;
+    if (acquired && has_last_healthy_) search_start = last_healthy_;
+    if (!hypotheses.empty() && (!acquired || acquisition_.dominance().dominant) &&
+        RotationErrorDeg(hypotheses.front().state.T_camera_lidar.linear(),
+                         search_start.T_camera_lidar.linear()) >= DominanceOptions().merge_deg) {
+      search_start = hypotheses.front().state;
     }
-    search_start = grid.state;
-    search_options->first_level = scorer->num_levels() - 1;
-    // δ while acquiring: the whole bounded range at the grid's rotation. The local search moves δ
-    // a few steps at a time against its prior around δ0 and cannot cross tens of milliseconds;
-    // an aliased profile (a second peak nearly as high) leaves δ where it was.
-    const TimeOffsetProfile profile =
-        was_acquiring && options_.acquire_time_offset && search_options->search_time_offset
-            ? ProfileTimeOffset(long_scorer, search_start, search_options->time_offset_bound_s,
-                                search_options->time_offset_step_s)
-            : TimeOffsetProfile();
-    if (!profile.scores.empty()) {
-      const double floor = *std::min_element(profile.scores.begin(), profile.scores.end());
-      const double best = *std::max_element(profile.scores.begin(), profile.scores.end());
-      const double current = long_scorer->Evaluate(search_start, -1).score;
-      if (!profile.alias_suspect &&
-          current - floor < options_.acquire_time_offset_keep_ratio * (best - floor)) {
-        search_start.time_offset_s = profile.best_s;
-      }
-      grid_evaluations += static_cast<int>(profile.offsets_s.size()) + 1;
-    }
+    VLOG(1) << "frame " << report->frame << ": best hypothesis "
+            << RotationErrorDeg(search_start.T_camera_lidar.linear(),
+                                state_.T_camera_lidar.linear())
+            << " deg from the estimate; " << acquisition_.dominance().detail << "; "
+            << DescribeRivals(acquisition_.dominance());
   }
-  if (grid_agrees) report->grid_agreement_frames = static_cast<int>(long_scorer->num_frames());
-  if (was_acquiring && grid_agrees &&
-      static_cast<int>(long_scorer->num_frames()) >= options_.refine_frames) {
-    UpdatePhase(static_cast<int>(scorer->num_frames()), report->health_before,
-                /*grid_agreed=*/true);
-  }
-  report->search = AdaptiveGridSearch(scorer, search_start, anchor_, *search_options);
-  report->search.evaluations += grid_evaluations;
+  report->search = AdaptiveGridSearch(scorer, search_start, anchor_, search_options);
+  report->search.evaluations += evaluations;
   report->search_ms = MillisecondsSince(start);
 }
 
-std::vector<OnlineCalibrator::Candidate> OnlineCalibrator::Candidates(
-    WindowScorer* scorer, const AdaptiveGridSearchOptions& search_options,
-    FrameReport* report) const {
+std::vector<OnlineCalibrator::Candidate> OnlineCalibrator::Candidates(FrameReport* report) const {
   // A candidate keeps the axes the refinement found unobservable where they were: a degenerate
   // scene (open road, poles only) must not move what it cannot see. Without a covariance the
-  // refined estimate cannot move and the search results move freely.
+  // refined estimate cannot move and the search result moves freely.
   std::string held;
   for (int k = 0; k < kNumAxes; ++k) {
     if (!report->refine.observable[k]) held += std::string(", held ") + kAxisNames[k];
@@ -619,14 +538,8 @@ std::vector<OnlineCalibrator::Candidate> OnlineCalibrator::Candidates(
   };
   const bool hold_search = report->refine.covariance_ok && !held.empty();
   if (report->refine.usable) add(report->refine.state, "refined", true, true);
-  add(report->search.state, "search", hold_search, false);
-  if (options_.search_from_last_healthy && report->coarse_search && has_last_healthy_ &&
-      RotationErrorDeg(last_healthy_.T_camera_lidar.linear(), state_.T_camera_lidar.linear()) >
-          options_.search.alpha3_rotation_deg) {
-    const SearchResult again = AdaptiveGridSearch(scorer, last_healthy_, anchor_, search_options);
-    report->search.evaluations += again.evaluations;
-    add(again.state, "search from the last healthy estimate", hold_search, false);
-  }
+  add(report->search.state, report->from_hypotheses ? "search from the best hypothesis" : "search",
+      hold_search, false);
   return candidates;
 }
 
@@ -655,7 +568,7 @@ void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowSc
   // edges pin the translation down only to a few cm (the polish holds its lateral and vertical
   // axes too), and the refinement's δ runs along its ridge with the forward translation.
   if (options_.refined_score_tolerance > 0 && !candidates.empty() && candidates.front().refined &&
-      chosen != 0 && !(report->coarse_search && report->acquiring)) {
+      chosen != 0 && !(report->from_hypotheses && report->acquiring)) {
     CalibrationState rotated = report->after;
     rotated.T_camera_lidar.linear() = candidates.front().state.T_camera_lidar.linear();
     const double value = WithinBounds(rotated, anchor_, search_options)
@@ -679,16 +592,16 @@ void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowSc
   // full jump.
   // The first update without the folds (full_step) moves the whole way, unless it is lost.
   const bool acquired = !report->acquiring && has_last_healthy_;
-  if (report->accepted && full_step && !report->coarse_search) {
+  if (report->accepted && full_step && !report->from_hypotheses) {
     report->reason = "folds dropped, a full step: " + report->reason;
-  } else if (report->accepted && (!report->coarse_search || acquired) &&
+  } else if (report->accepted && (!report->from_hypotheses || acquired) &&
              options_.tracking_gain < 1.0) {
     const CalibrationState& c = report->after;
     const double g = options_.tracking_gain;
     const Eigen::Vector3d rotation =
         LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear());
     const double g_rotation =
-        report->coarse_search ? 1.0
+        report->from_hypotheses ? 1.0
                               : TrackingRotationShare(g, rotation.norm(),
                                                       options_.tracking_max_lag_deg * M_PI / 180.0);
     report->after = Step(state_, g_rotation * rotation,

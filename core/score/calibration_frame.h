@@ -38,6 +38,10 @@ struct FrameImageAndMotion {
   // The finest score maps are the band-pass IDTs, whose positive parts are the texture-suppressed
   // IDTs (ImageFeatures::idt_suppressed, which the frame then need not keep: TextureSuppressedMap).
   bool score_maps_bandpass = false;
+  // The acquisition's coarse maps per edge kind (CoarseScoreMap): CV_32F at 1/coarse_map_scale
+  // of the image size, one zero cell of padding on each side; empty: the frame has none.
+  std::array<cv::Mat, 2> coarse_map;
+  int coarse_map_scale = 0;
   // > 0: the frame keeps no gray_map; its plain IDT is 255·(1 − distance_px/gray_basin_px), as
   // the image features make it from the same distance map (PlainIdt) [px].
   double gray_basin_px = 0;

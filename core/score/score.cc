@@ -170,42 +170,6 @@ ScoreValue WindowScorer::EvaluateFrame(size_t f, const CalibrationState& state, 
   return EvaluateLevel(state, level, f, f + 1);
 }
 
-std::vector<ScoreValue> WindowScorer::EvaluateFramePerState(
-    size_t f, const std::vector<CalibrationState>& states, int level) {
-  CHECK_LT(f, frames_.size());
-  std::vector<ScoreValue> values(states.size());
-  if (states.empty()) return values;
-  const CalibrationFrame& cf = *frames_[f];
-  const MapView maps[2] = {MapView(ScoreMapAt(cf, 0, level)), MapView(ScoreMapAt(cf, 1, level))};
-  const Rigid3d Tv = LidarMotion(cf.twist, cf.e0_s + states[0].time_offset_s);
-  std::vector<FrameProjection> projections;
-  projections.reserve(states.size());
-  for (const CalibrationState& state : states) {
-    CHECK_EQ(state.time_offset_s, states[0].time_offset_s) << "EvaluateFramePerState: one δ";
-    projections.push_back(
-        ProjectionOf(cf, state.T_camera_lidar.linear(), state.T_camera_lidar.translation(), Tv));
-  }
-  // The same arithmetic as EvaluateOn, each state's sums point by point in order.
-  const std::vector<Eigen::Vector3d>& points = points_[f];
-  double weight_sum = 0;
-  for (size_t k = 0; k < points.size(); ++k) {
-    const float w = weights_[f][k];
-    weight_sum += w;
-    const MapView& map = maps[kinds_[f][k]];
-    for (size_t n = 0; n < states.size(); ++n) {
-      const FrameProjection& p = projections[n];
-      if (p.depth_row.dot(points[k]) + p.depth_offset < cf.camera.min_depth_m) continue;
-      const Eigen::Vector3d h = p.M * points[k] + p.b;
-      AddProjection(h, map, w, &values[n]);
-    }
-  }
-  for (ScoreValue& value : values) {
-    value.gray_rate = weight_sum > 0 ? value.score / 255.0 / weight_sum : 0.0;
-    value.weight_sum = weight_sum;
-  }
-  return values;
-}
-
 double WindowScorer::GrayRate(const CalibrationState& state) {
   // A frame that keeps no plain IDT has it made from its distance map (PlainIdt). A scorer over
   // a few frames (the search window, whose search reads the gray rate at every step) keeps what

@@ -52,13 +52,6 @@ class WindowScorer {
   // Evaluate() on frame `f` alone. The window's score is the sum of these in frame order up to
   // rounding (Evaluate() accumulates point by point across frames).
   ScoreValue EvaluateFrame(size_t f, const CalibrationState& state, int level);
-  // EvaluateFrame() of each of `states` (all at one δ, any rotations), bit for bit: point by point
-  // over all states, so that one point's samples under nearby calibrations are read while its
-  // part of the map is in the cache (state by state, every point, the frame's maps are read
-  // again for each state). For many rotations of one frame: the rotation grid.
-  std::vector<ScoreValue> EvaluateFramePerState(size_t f,
-                                                const std::vector<CalibrationState>& states,
-                                                int level);
 
  private:
   // Evaluates frames [begin, end) on the map `map_of(frame, kind)`.

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -58,40 +57,6 @@ struct SearchResult {
 SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& start,
                                 const CalibrationState& anchor,
                                 const AdaptiveGridSearchOptions& options);
-
-// Exhaustive rotation grid: roll, pitch and yaw offsets in [−half_range_deg, half_range_deg] at
-// step_deg about the LiDAR axes (translation and δ as in `center`), scored on `level`, inside
-// the bounds around `anchor`. The first stage when the estimate is lost: the band-pass score's
-// peak is narrow (about ±1° on KITTI) but global, so a dense grid finds it where a local search
-// from 2° away climbs a side peak.
-struct RotationGridResult {
-  CalibrationState state;  ///< the best grid point (`center` when nothing scored better)
-  double score = 0;        ///< its score on `level`
-  int evaluations = 0;     ///< lattice points compared (scored now or taken from the cache)
-};
-
-// What the per-frame scores of RotationGridSearch's lattice depend on besides the frame. While
-// acquiring, the calibrator runs the grid on a window that grows by one frame per call; with a
-// RotationGridCache a frame scored by an earlier call over the same lattice is not scored again.
-struct RotationGridLattice {
-  Eigen::Matrix4d center;
-  double center_time_offset_s, half_range_deg, step_deg;
-  int level;
-  double horizontal_weight;
-  int max_points_per_frame;
-  std::vector<uint8_t> in_bounds;  // per lattice point
-  bool operator==(const RotationGridLattice& o) const;
-};
-using RotationGridCache = FrameScoreCache<RotationGridLattice>;  // per lattice point (0 outside)
-
-// `cache` (optional): reuse the per-frame scores of earlier calls (see RotationGridCache). The
-// result is the same with or without it: the window's score at a lattice point is the sum of
-// its per-frame scores in frame order either way.
-RotationGridResult RotationGridSearch(WindowScorer* scorer, const CalibrationState& center,
-                                      const CalibrationState& anchor,
-                                      const AdaptiveGridSearchOptions& options,
-                                      double half_range_deg, double step_deg, int level = -1,
-                                      RotationGridCache* cache = nullptr);
 
 // True when `state` is within the rotation/translation bounds around `anchor`.
 bool WithinBounds(const CalibrationState& state, const CalibrationState& anchor,
