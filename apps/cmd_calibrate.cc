@@ -214,7 +214,6 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     source_options.view_margin_deg =
         std::max(source_options.view_margin_deg, job.online.search.max_rotation_offset_deg + 10.0);
   }
-  source_options.image.pyramid_basins_px.clear();  // the search reads the finest map only
   std::unique_ptr<DriveFrameSource> source;
   status = DriveFrameSource::Create(&drive, source_options, &source);
   if (!status.ok()) return ReportError(kCommand, status);
@@ -397,6 +396,32 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
     }
   }
   if (updates > 0) update_ms /= updates;
+  // The acquisition's hypotheses as last compared (best first), with each runner-up's margins.
+  nlohmann::json hypotheses_json = nlohmann::json::array();
+  {
+    const Acquisition& acquisition = calibrator.acquisition();
+    const Dominance& dominance = acquisition.dominance();
+    for (size_t k = 0; k < acquisition.hypotheses().size(); ++k) {
+      const Hypothesis& h = acquisition.hypotheses()[k];
+      const Eigen::Vector3d h_rpy = MountRollPitchYawDeg(h.state.T_camera_lidar.linear());
+      const Eigen::Vector3d t = h.state.T_camera_lidar.translation();
+      nlohmann::json entry = {
+          {"best", static_cast<int>(k) == dominance.best},
+          {"rpy_deg", {{"roll", h_rpy.x()}, {"pitch", h_rpy.y()}, {"yaw", h_rpy.z()}}},
+          {"translation_m", {{"x", t.x()}, {"y", t.y()}, {"z", t.z()}}},
+          {"time_offset_s", h.state.time_offset_s},
+          {"lattice_score", h.lattice_score}};
+      if (static_cast<int>(k) != dominance.best && k < dominance.rivals.size()) {
+        const RivalMargin& r = dominance.rivals[k];
+        entry["rotation_from_best_deg"] = r.rotation_deg;
+        entry["score_share_below_best"] = r.score_share;
+        entry["standard_errors_below_best"] =
+            std::isfinite(r.t_statistic) ? nlohmann::json(r.t_statistic) : nlohmann::json(nullptr);
+        entry["same_peak_as_best"] = r.merged;
+      }
+      hypotheses_json.push_back(entry);
+    }
+  }
   nlohmann::json result = {
       {"T_camera_lidar", MatrixJson(outcome->estimate.T_camera_lidar)},
       {"time_offset_s", outcome->estimate.time_offset_s},
@@ -414,6 +439,11 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"converged", outcome->converged},
       {"reason", outcome->reason},
       {"phase", PhaseName(calibrator.phase())},
+      {"hypotheses", hypotheses_json},
+      {"dominance",
+       {{"frames", calibrator.acquisition().dominance().frames},
+        {"dominant", calibrator.acquisition().dominance().dominant},
+        {"detail", calibrator.acquisition().dominance().detail}}},
       {"verdict_rules", rules_json},
       {"alias_suspect", outcome->alias_suspect},
       {"time_offset_peak_s", profile.best_s},

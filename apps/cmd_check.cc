@@ -61,7 +61,6 @@ int RunCheck() {
   FrameSourceOptions source_options;
   source_options.suppress_texture = true;
   source_options.local_map.sweeps = FLAGS_local_map_sweeps;
-  source_options.image.pyramid_basins_px.clear();  // the health check reads the finest map only
   status = ImageOptionsFromFlags(&source_options.image);  // the edges calibrate read
   if (!status.ok()) return UsageError(kCommand, status.message());
   source_options.view_T_camera_lidar = calibration.T_camera_lidar;  // the view it checks

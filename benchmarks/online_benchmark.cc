@@ -14,18 +14,14 @@
 #include "core/online/frame_source.h"
 #include "core/online/online_calibrator.h"
 #include "core/search/adaptive_grid_search.h"
+#include "core/search/hypothesis_lattice.h"
 #include "core/types/calibration.h"
 
 namespace stcalib {
 namespace {
 
-// The frame source as `stcalib calibrate` sets it up with the defaults: no pyramid that the
-// search never reads.
-FrameSourceOptions CalibrateSourceOptions() {
-  FrameSourceOptions options;
-  if (!OnlineCalibratorOptions().ReadsCoarseLevels()) options.image.pyramid_basins_px.clear();
-  return options;
-}
+// The frame source as `stcalib calibrate` sets it up with the defaults.
+FrameSourceOptions CalibrateSourceOptions() { return FrameSourceOptions(); }
 
 // A new frame source (its sweep cache empty) that has loaded frames [0, n), each handed to
 // `use` (may be empty): the untimed start of a benchmark cycle over later frames.
@@ -94,7 +90,7 @@ void BM_OnlineUpdate(benchmark::State& state) {
     state.ResumeTiming();
     const FrameReport report = calibrator.AddFrame(frame);
     if (report.skipped) return state.SkipWithError(report.reason.c_str());
-    coarse += report.coarse_search;
+    coarse += report.from_hypotheses;
     next = next + 1 < Kitti().frames.size() ? next + 1 : 8;
   }
   state.SetLabel("refine over " + std::to_string(state.range(0)) + " frames, search over 3" +
@@ -111,9 +107,9 @@ CalibrationState KittiStartTwoDegreesOff() {
 }
 
 // One acquiring frame: the calibrator, started 2° off, has taken frames [0, N); the timed
-// AddFrame of frame N runs the rotation grid over the window (its cache holding the earlier
-// frames' scores while the translation and δ stayed), the δ scan, the search and the
-// refinement. Counters: the frame's search and refinement [ms].
+// AddFrame of frame N scores the frame once over the lattice, refines and judges the best
+// hypotheses, then searches and refines the estimate. Counters: the frame's search (hypotheses
+// included) and refinement [ms].
 void BM_AcquiringFrame(benchmark::State& state) {
   if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
   const size_t n = static_cast<size_t>(state.range(0));
@@ -187,7 +183,7 @@ void BM_TrackingFrame(benchmark::State& state) {
   state.counters["max_ms"] = frame_ms.back();
   state.counters["max_search_ms"] = worst.search_ms;
   state.counters["max_refine_ms"] = worst.refine_ms;
-  state.counters["max_was_lost"] = worst.coarse_search ? 1 : 0;
+  state.counters["max_was_lost"] = worst.from_hypotheses ? 1 : 0;
   state.SetLabel(acquiring > 0 ? std::to_string(acquiring) + " frames acquiring" : "tracking");
 }
 BENCHMARK(BM_TrackingFrame)->Unit(benchmark::kMillisecond);
@@ -228,47 +224,33 @@ void BM_CalibrateLoopPerFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_CalibrateLoopPerFrame)->Unit(benchmark::kMillisecond)->Iterations(2);
 
-// The acquisition's rotation grid (±3° at 0.5°: 13³ = 2197 candidates) over N frames; it runs
-// on every frame while acquiring and when lost, not while tracking.
-void BM_RotationGrid(benchmark::State& state) {
+// One frame scored once over the acquisition's lattice (the default start uncertainty, ±5°,
+// ±20 cm, ±100 ms): what every acquiring frame adds. Counters: points read and hypotheses
+// scored; the inner loop is vectorised (ScoreFrameOnLattice's clones), so `ns_per_sample`
+// (ns per point and hypothesis) shows whether a wide vector unit ran it.
+void BM_LatticeFrame(benchmark::State& state) {
   if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
-  const CalibrationState initial = KittiCalibration();
-  const std::vector<const CalibrationFrame*> frames = FirstFrames(state.range(0));
-  WindowScorer scorer(frames, ScoreOptions());
+  HypothesisLattice lattice;
+  if (!HypothesisLattice::Create(KittiStartTwoDegreesOff(), StartUncertainty(), LatticeSteps(),
+                                 &lattice)
+           .ok()) {
+    return state.SkipWithError("lattice");
+  }
+  const auto frame = PruneToImage(*Kitti().frames[5], KittiStartTwoDegreesOff(),
+                                  OnlineCalibratorOptions().point_margin);
+  const int points = std::min<int>(frame->size(), Acquisition::kLatticePoints);
+  std::vector<float> scores;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(
-        RotationGridSearch(&scorer, initial, initial, AdaptiveGridSearchOptions(), 3.0, 0.5));
+    ScoreFrameOnLattice(*frame, lattice, 0.2, Acquisition::kLatticePoints, &scores);
+    benchmark::DoNotOptimize(scores.data());
   }
-  state.SetLabel("2197 rotations over " + std::to_string(state.range(0)) + " frames");
+  state.counters["points"] = points;
+  state.counters["hypotheses"] = static_cast<double>(lattice.size());
+  state.counters["ns_per_sample"] = benchmark::Counter(
+      static_cast<double>(points) * lattice.size() * 1e-9,
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_RotationGrid)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
-
-// The same grid as the calibrator runs it while acquiring: with a RotationGridCache that already
-// holds the window's first N − 1 frames (the previous frame's grid), so only the new frame is
-// scored over the lattice.
-void BM_RotationGridCachedNewFrame(benchmark::State& state) {
-  if (!Kitti().ok) return state.SkipWithError("shared KITTI data not found");
-  const CalibrationState initial = KittiCalibration();
-  const std::vector<const CalibrationFrame*> frames = FirstFrames(state.range(0));
-  RotationGridCache previous;
-  {
-    WindowScorer scorer(std::vector<const CalibrationFrame*>(frames.begin(), frames.end() - 1),
-                        ScoreOptions());
-    RotationGridSearch(&scorer, initial, initial, AdaptiveGridSearchOptions(), 3.0, 0.5, -1,
-                       &previous);
-  }
-  for (auto _ : state) {
-    state.PauseTiming();
-    RotationGridCache cache = previous;
-    state.ResumeTiming();
-    WindowScorer scorer(frames, ScoreOptions());
-    benchmark::DoNotOptimize(RotationGridSearch(&scorer, initial, initial,
-                                                AdaptiveGridSearchOptions(), 3.0, 0.5, -1, &cache));
-  }
-  state.SetLabel("2197 rotations over " + std::to_string(state.range(0)) + " frames, " +
-                 std::to_string(state.range(0) - 1) + " of them cached");
-}
-BENCHMARK(BM_RotationGridCachedNewFrame)->Arg(3)->Arg(12)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LatticeFrame)->Unit(benchmark::kMillisecond);
 
 // The health score (docs/method.md §7): 728 neighbours of the estimate scored over N frames; an
 // online update measures it before and after, and every 6-DoF search step scores as many.
@@ -343,7 +325,7 @@ void BM_WholeFrame(benchmark::State& state) {
     if (!source->Load(next++, frame.get()).ok()) return state.SkipWithError("load");
     const FrameReport report = calibrator->AddFrame(frame);
     if (report.skipped) return state.SkipWithError(report.reason.c_str());
-    coarse += report.coarse_search;
+    coarse += report.from_hypotheses;
   }
   state.SetLabel(
       "features + update every " + std::to_string(options.tracking_update_every) +

@@ -40,8 +40,6 @@ void BM_SoakReplayedDrive(benchmark::State& state) {
   }
   cv::setNumThreads(1);
   FrameSourceOptions source_options;
-  if (!OnlineCalibratorOptions().ReadsCoarseLevels())
-    source_options.image.pyramid_basins_px.clear();
   const int frames = static_cast<int>(drive.NumFrames());
   const int total = static_cast<int>(state.range(0));
   const int checkpoints[] = {20, 60, 200, 600};

@@ -17,6 +17,7 @@
 #include "core/online/online_calibrator.h"
 #include "core/refine/refine.h"
 #include "core/search/adaptive_grid_search.h"
+#include "core/search/hypothesis_lattice.h"
 #include "core/sim/simulator.h"
 #include "test/test_util.h"
 
@@ -234,23 +235,19 @@ TEST(OnlineCalibrator, WithoutFoldsDropsFoldsWithTheirEntries) {
 }
 
 // What the calibrator's window holds of a frame with a fold: kKeep all four points, kDrop three;
-// kDropWhenTracking four as long as it acquires, and also without the grid's acquisition (there
-// is none to end).
+// kDropWhenTracking four as long as it acquires.
 TEST(OnlineCalibrator, FoldsInTheWindowFollowTheOption) {
   using Folds = OnlineCalibratorOptions::Folds;
-  for (const auto& [folds, grid_deg, points] :
-       {std::tuple{Folds::kKeep, 3.0, 4u}, std::tuple{Folds::kDrop, 3.0, 3u},
-        std::tuple{Folds::kDropWhenTracking, 3.0, 4u},
-        std::tuple{Folds::kDropWhenTracking, 0.0, 4u}}) {
+  for (const auto& [folds, points] : {std::tuple{Folds::kKeep, 4u}, std::tuple{Folds::kDrop, 3u},
+                                      std::tuple{Folds::kDropWhenTracking, 4u}}) {
     OnlineCalibratorOptions options;
     options.folds = folds;
-    options.lost_grid_deg = grid_deg;
     OnlineCalibrator calibrator(options, CalibrationState());
     const FrameReport r = calibrator.AddFrame(FrameWithAFold(0, 1.0));
     EXPECT_NE(r.reason.find("too few LiDAR edge points"), std::string::npos) << r.reason;
     ASSERT_EQ(calibrator.RecentFrames().size(), 1u);
     EXPECT_EQ(calibrator.RecentFrames()[0]->size(), points)
-        << FoldsName(folds) << ", grid " << grid_deg;
+        << FoldsName(folds);
     EXPECT_EQ(calibrator.SearchWindow()[0], calibrator.RecentFrames()[0].get());
   }
   OnlineCalibratorOptions::Folds parsed = OnlineCalibratorOptions::Folds::kKeep;
@@ -260,8 +257,6 @@ TEST(OnlineCalibrator, FoldsInTheWindowFollowTheOption) {
   EXPECT_EQ(parsed, OnlineCalibratorOptions::Folds::kDropWhenTracking);
 }
 
-// The refinement's loss: refine.loss while acquiring, acquired_loss once acquired (with no
-// rotation grid there is no acquisition); the names parse both ways.
 // A tracking update takes tracking_gain of a small move (scatter) and all but
 // tracking_max_lag_deg of a large one (a correction); the two agree where they meet, so the
 // step grows continuously with the move.
@@ -282,28 +277,17 @@ TEST(OnlineCalibrator, TrackingRotationShareLagsALargeMoveByTheMaxLagOnly) {
   EXPECT_DOUBLE_EQ(TrackingRotationShare(1.0, 1.0, lag), 1.0);  // full steps stay full
 }
 
+// The refinement's loss: refine.loss while acquiring (kAcquiredLoss once acquired, which the
+// stages' test below reaches); the names parse both ways.
 TEST(OnlineCalibrator, AcquiredLossOnceAcquired) {
   OnlineCalibratorOptions options;
   options.refine.loss = RefineOptions::Loss::kCauchy;
   options.refine.loss_scale_px = 1.0;
-  options.acquired_loss = RefineOptions::Loss::kTukey;
-  options.acquired_loss_scale_px = 5.0;
-  ASSERT_GT(options.lost_grid_deg, 0);
   const OnlineCalibrator acquiring(options, CalibrationState());
   ASSERT_TRUE(acquiring.acquiring());
   EXPECT_EQ(acquiring.RefineOptionsInUse().loss, RefineOptions::Loss::kCauchy);
-  EXPECT_EQ(acquiring.RefineOptionsInUse(/*polish=*/true).loss_scale_px, 1.0);
-  options.lost_grid_deg = 0;
-  const OnlineCalibrator acquired(options, CalibrationState());
-  ASSERT_FALSE(acquired.acquiring());
-  EXPECT_EQ(acquired.RefineOptionsInUse().loss, RefineOptions::Loss::kTukey);
-  EXPECT_EQ(acquired.RefineOptionsInUse().loss_scale_px, 5.0);
-  options.acquired_loss_when_tracking = false;
-  const OnlineCalibrator polish_only(options, CalibrationState());
-  EXPECT_EQ(polish_only.RefineOptionsInUse().loss, RefineOptions::Loss::kCauchy);
-  EXPECT_EQ(polish_only.RefineOptionsInUse(/*polish=*/true).loss, RefineOptions::Loss::kTukey);
-  options.acquired_loss_scale_px = 0;
-  EXPECT_FALSE(options.Validate().ok());
+  EXPECT_EQ(acquiring.RefineOptionsInUse().loss_scale_px, 1.0);
+  ASSERT_NE(kAcquiredLoss, RefineOptions::Loss::kCauchy);
   for (RefineOptions::Loss loss :
        {RefineOptions::Loss::kHuber, RefineOptions::Loss::kCauchy, RefineOptions::Loss::kTukey}) {
     RefineOptions::Loss parsed = RefineOptions::Loss::kHuber;
@@ -337,57 +321,51 @@ TEST(OnlineCalibrator, SharedSettingsReachScoreSearchAndRefine) {
   EXPECT_FALSE(options.Validate().ok());
 }
 
-// --init_uncertainty's figures: parsed with errors naming the text; a start within the defaults
-// leaves every setting as it is, a wider one widens the grid, the bounds (norms over three axes)
-// and the priors to hold it, and the δ bound to reach around δ0.
-TEST(OnlineCalibrator, StartUncertaintyWidensOnlyWhatTheDefaultsDoNotHold) {
+// --init_uncertainty's figures: parsed with errors naming the text; a start within the defaults'
+// bounds and priors leaves them as they are, a wider one widens the bounds (norms over three
+// axes, holding the lattice's reach) and the priors to hold it, and the δ bound to reach around
+// δ0.
+TEST(OnlineCalibrator, StartUncertaintySetsTheBoundsAndPriors) {
   StartUncertainty u;
-  ASSERT_TRUE(ParseStartUncertainty("", &u).ok());
-  EXPECT_EQ(u.rotation_deg, 0.0);
   ASSERT_TRUE(ParseStartUncertainty("5,0.2,0.1", &u).ok());
   EXPECT_EQ(u.rotation_deg, 5.0);
   EXPECT_EQ(u.translation_m, 0.2);
   EXPECT_EQ(u.time_offset_s, 0.1);
-  for (const char* bad :
-       {"5,0.2", "5,0.2,0.1,1", "5,,0.1", "5,x,0.1", "-1,0.2,0.1", "5,nan,0.1", "5,0.2,0.1,"}) {
+  EXPECT_EQ(StartUncertaintyText(u), "5,0.2,0.1");
+  for (const char* bad : {"", "5,0.2", "5,0.2,0.1,1", "5,,0.1", "5,x,0.1", "-1,0.2,0.1",
+                          "0,0.2,0.1", "5,nan,0.1", "5,0.2,0.1,"}) {
     const Status status = ParseStartUncertainty(bad, &u);
     EXPECT_FALSE(status.ok()) << bad;
     EXPECT_THAT(status.message(), ::testing::HasSubstr(std::string("--init_uncertainty=") + bad));
   }
 
-  const OnlineCalibratorOptions defaults;
-  StartUncertainty within;
-  within.rotation_deg = 2;
-  within.translation_m = 0.05;
-  within.time_offset_s = 0.03;
-  const OnlineCalibratorOptions same = ForStartUncertainty(defaults, within, 0.0);
-  EXPECT_EQ(same.wide_grid_deg, 0.0);
-  EXPECT_EQ(same.wide_time_offset_s, 0.0);
-  EXPECT_EQ(same.lost_grid_deg, defaults.lost_grid_deg);
-  EXPECT_EQ(same.search.max_rotation_offset_deg, defaults.search.max_rotation_offset_deg);
+  OnlineCalibratorOptions defaults;
+  defaults.start_uncertainty = {2, 0.05, 0.03};
+  const OnlineCalibratorOptions same = WithStartUncertainty(defaults, 0.0);
   EXPECT_EQ(same.search.max_translation_offset_m, defaults.search.max_translation_offset_m);
   EXPECT_EQ(same.search.translation_prior_sigma_m, defaults.search.translation_prior_sigma_m);
   EXPECT_EQ(same.refine.prior_sigma_translation_m, defaults.refine.prior_sigma_translation_m);
   EXPECT_EQ(same.refine.prior_sigma_time_s, defaults.refine.prior_sigma_time_s);
   EXPECT_EQ(same.time_offset_bound_s, defaults.time_offset_bound_s);
 
-  const StartUncertainty wide{5, 0.2, 0.1};
-  const OnlineCalibratorOptions widened = ForStartUncertainty(defaults, wide, -0.1);
-  EXPECT_EQ(widened.wide_grid_deg, 6.0);       // the start's error plus the peak's basin
-  EXPECT_EQ(widened.wide_time_offset_s, 0.1);  // the wide grids also at δ0 ± 50 and ± 100 ms
-  EXPECT_EQ(widened.lost_grid_deg, defaults.lost_grid_deg);
+  OnlineCalibratorOptions wide_options;
+  wide_options.start_uncertainty = {5, 0.2, 0.1};
+  const OnlineCalibratorOptions widened = WithStartUncertainty(wide_options, -0.1);
   // A truth 5° off on each axis, 0.2 m on each, and δ 0.1 s beyond δ0 lies inside the bounds.
   CalibrationState start;
   CalibrationState truth =
       Step(start, Eigen::Vector3d(5, -5, 5) * M_PI / 180.0, Eigen::Vector3d(0.2, -0.2, 0.2), -0.2);
   start.time_offset_s = -0.1;
-  EXPECT_FALSE(WithinBounds(truth, start, defaults.search));
+  EXPECT_FALSE(WithinBounds(truth, start, OnlineCalibratorOptions().search));
   EXPECT_TRUE(WithinBounds(truth, start, WithSharedSettings(widened).search));
   EXPECT_EQ(widened.refine.prior_sigma_translation_m, 0.2);
   EXPECT_EQ(widened.search.translation_prior_sigma_m, 0.2);
   EXPECT_EQ(widened.refine.prior_sigma_time_s, 0.1);
   EXPECT_EQ(widened.search.time_offset_prior_sigma_s, 0.1);
+  EXPECT_GE(widened.time_offset_bound_s, 0.2);
   EXPECT_TRUE(widened.Validate().ok());
+  wide_options.start_uncertainty.time_offset_s = 0;
+  EXPECT_FALSE(wide_options.Validate().ok());
 }
 
 TEST(Calibration, StagesAgainstSimulatedTruth) {
@@ -416,7 +394,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   }
   // The stages run on what the calibrator gives them: six frames pruned to the image at the
   // start (OnlineCalibrator::AddFrame does the same). On three frames the roll of this drive is
-  // weak: whether the grid and the search end 0.2 or 1.2 deg off in roll there depends on which
+  // weak: whether the search ends 0.2 or 1.2 deg off in roll there depends on which
   // points the scorer's thinning keeps (measured over windows 2-4, 3-5, 4-6, pruned or not, 600
   // points or all). On six frames every such variant ends within the bounds asserted below.
   const CalibrationState start =
@@ -456,25 +434,6 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
       ASSERT_EQ(batch[n].gray_rate, single.gray_rate);
     }
   }
-  // The rotation grid's pass (EvaluateFramePerState: any rotations and translations, one δ) equals
-  // EvaluateFrame state by state, bit for bit, on every frame.
-  {
-    std::vector<CalibrationState> states;
-    for (const Eigen::Matrix<double, 6, 1>& d : NeighbourDirections(true)) {
-      states.push_back(Step(one_off, 0.02 * d.head<3>(), 0.05 * d.tail<3>(), 0.0));
-    }
-    for (size_t f = 0; f < scorer.num_frames(); ++f) {
-      const std::vector<ScoreValue> batch = scorer.EvaluateFramePerState(f, states, -1);
-      ASSERT_EQ(batch.size(), states.size());
-      for (size_t n = 0; n < states.size(); ++n) {
-        const ScoreValue single = scorer.EvaluateFrame(f, states[n], -1);
-        ASSERT_EQ(batch[n].score, single.score) << "frame " << f << ", state " << n;
-        ASSERT_EQ(batch[n].projected, single.projected) << "frame " << f << ", state " << n;
-        ASSERT_EQ(batch[n].weight_sum, single.weight_sum);
-      }
-    }
-  }
-
   // The health cache: a window sliding one frame at a time with the estimate unchanged scores
   // only its newest frame, and every health and best gain equals the uncached one exactly; a
   // moved estimate, or a frame replaced at the same address by a later one, is scored afresh.
@@ -504,21 +463,21 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     reused = saved;
   }
 
-  // Search: coarse-to-fine from 2° on every axis (3.46°) comes back to pitch and yaw; roll, weak
-  // on these frames, ends on one of a few steps 0.2–1.0° off, by horizontal-edge weight and
-  // thinning alone (measured over w 0.2/0.35/0.5 with 600 points or all: 1.01, 1.01, 0.21,
-  // 0.82, 0.62, 0.62°; before the folds were moved to their tops' far sides 1.01, 1.01, 0.82,
-  // 0.82, 0.21, 0.21°). The calibrator does not rely on it alone: the rotation grid comes first.
+  // Search on the finest map from 0.6° on every axis (1.04°, within its peak's basin, where the
+  // calibrator starts it from the best hypothesis): back to pitch and yaw within a few tenths;
+  // roll, weak on these frames, within a degree, by horizontal-edge weight and thinning alone.
   for (const double w : {0.2, 0.35, 0.5}) {
     for (const int points : {600, 0}) {
       ScoreOptions variant;
       variant.horizontal_weight = w;
       variant.max_points_per_frame = points;
       WindowScorer variant_scorer(window, variant);
-      const SearchResult result =
-          AdaptiveGridSearch(&variant_scorer, start, start, AdaptiveGridSearchOptions());
+      const CalibrationState near_start =
+          Step(truth, Eigen::Vector3d(0.6, -0.6, 0.6) * M_PI / 180.0, Eigen::Vector3d::Zero(), 0);
+      const SearchResult result = AdaptiveGridSearch(&variant_scorer, near_start, near_start,
+                                                     AdaptiveGridSearchOptions());
       const CalibrationError error = ComputeCalibrationError(result.state, truth);
-      std::printf("search from 3.46 deg, w %.2f, %d points: %s\n", w, points,
+      std::printf("search from 1.04 deg, w %.2f, %d points: %s\n", w, points,
                   ToString(error).c_str());
       EXPECT_LT(error.rotation_deg, 1.1) << "w " << w << ", points " << points;
       EXPECT_LT(std::abs(error.pitch_deg), 0.2) << "w " << w << ", points " << points;
@@ -527,92 +486,101 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     }
   }
 
-  // Rotation grid (±3° at 0.5°) around a start 3.5° off: its best point is within about a grid
-  // step of the truth on each axis; every point lies inside the 6° bound, so all 13³ are scored.
-  // (Offsets off the grid's lattice, so that the truth is not one of its points.)
-  const CalibrationState start_true_delta =
-      Step(truth, Eigen::Vector3d(2.2, -1.8, 2.1) * M_PI / 180.0, Eigen::Vector3d::Zero(), 0.0);
-  const RotationGridResult grid = RotationGridSearch(&scorer, start_true_delta, start_true_delta,
-                                                     AdaptiveGridSearchOptions(), 3.0, 0.5);
-  const CalibrationError grid_error = ComputeCalibrationError(grid.state, truth);
-  std::printf("rotation grid from %.2f deg: %s\n",
-              ComputeCalibrationError(start_true_delta, truth).rotation_deg,
-              ToString(grid_error).c_str());
-  EXPECT_EQ(grid.evaluations, 13 * 13 * 13);
-  // Measured on the default (band-pass) score maps: 0.83° (roll −0.81, the weak axis of this
-  // drive; pitch +0.18, yaw +0.09), the same lattice point on every six-frame variant; within the
-  // search's basin, which is what the grid is for.
-  EXPECT_LT(grid_error.rotation_deg, 1.0);
-  EXPECT_LT(std::abs(grid_error.roll_deg), 1.0);
-  EXPECT_LT(std::abs(grid_error.pitch_deg), 0.5);
-  EXPECT_LT(std::abs(grid_error.yaw_deg), 0.5);
-  EXPECT_GT(grid.score, scorer.Evaluate(start_true_delta, -1).score);
-
-  // The grid's cache (the calibrator's while acquiring): on a window growing one frame at a time
-  // and then sliding, the cached grid finds the best lattice point of a brute-force pass with
-  // WindowScorer::Evaluate (the sum over frames up to rounding), gives the uncached grid's result
-  // bit for bit and scores each frame once; another translation or δ scores them all again; two
-  // different frames under the same key are both scored.
+  // The acquisition's lattice at ±5°, ±20 cm, ±100 ms around a start 3.5° off in rotation, 6 cm in
+  // translation and δ0 30 ms off, none of them on a lattice point:
+  // - one frame's score vector equals a direct evaluation: each thinned point projected by
+  //   ProjectFramePoint (the scorer's projection) and read at its nearest coarse cell;
+  // - the window's running sums equal the sum of its frames' vectors, a frame leaving subtracted;
+  // - the best hypothesis lies within a step of the truth on every axis.
   {
-    // The best lattice point by brute force on the whole-window score.
-    auto brute_force_best = [&](WindowScorer* scorer, const CalibrationState& centre) {
-      double best = -std::numeric_limits<double>::infinity();
-      for (int a = -6; a <= 6; ++a) {
-        for (int b = -6; b <= 6; ++b) {
-          for (int c = -6; c <= 6; ++c) {
-            best = std::max(
-                best, scorer
-                          ->Evaluate(Step(centre, Eigen::Vector3d(a, b, c) * 0.5 * M_PI / 180.0,
-                                          Eigen::Vector3d::Zero(), 0.0),
-                                     -1)
-                          .score);
-          }
-        }
+    const CalibrationState lattice_start = Step(truth, Eigen::Vector3d(2.2, -1.8, 2.1) * M_PI / 180,
+                                                Eigen::Vector3d(0.03, -0.03, 0.04), -0.03);
+    const StartUncertainty wide{5, 0.2, 0.1};
+    HypothesisLattice lattice;
+    ASSERT_TRUE(HypothesisLattice::Create(lattice_start, wide, LatticeSteps(), &lattice).ok());
+    const size_t expected = 11 * 15 * 5 * 5 * 3;  // rotations (x, y, z), δ, translations
+    EXPECT_EQ(lattice.size(), expected);
+    EXPECT_EQ(HypothesisLattice::CountFor(wide, LatticeSteps()), expected);
+    EXPECT_EQ(HypothesisLattice::CountFor(StartUncertainty(), LatticeSteps()), 7u * 9 * 3 * 3 * 1);
+    // Every rotation offset within the span lies within half a step of a lattice rotation on
+    // each axis (corners and a few points inside).
+    const Eigen::Vector3d steps_deg = LatticeSteps().rotation_deg;
+    for (const Eigen::Vector3d& v : std::vector<Eigen::Vector3d>{Eigen::Vector3d(5, 5, 5), Eigen::Vector3d(-5, 4.6, -0.3),
+                                     Eigen::Vector3d(1.1, -2.9, 4.99), Eigen::Vector3d(0, 0, 0)}) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (size_t r = 0; r < lattice.num_rotations(); ++r) {
+        const Eigen::Vector3d offset_deg =
+            lattice.RotationOffsetRad(r * lattice.num_time_offsets() * lattice.num_translations()) *
+            180.0 / M_PI;
+        nearest = std::min(nearest, (offset_deg - v).cwiseQuotient(steps_deg).cwiseAbs().maxCoeff());
       }
-      return best;
-    };
-    RotationGridCache cache;
-    auto grid_on = [&](const std::vector<const CalibrationFrame*>& frames_in,
-                       const CalibrationState& centre, RotationGridCache* with, double* brute) {
-      WindowScorer part(frames_in, ScoreOptions());
-      const RotationGridResult grid = RotationGridSearch(
-          &part, centre, start_true_delta, AdaptiveGridSearchOptions(), 3.0, 0.5, -1, with);
-      if (brute != nullptr) *brute = brute_force_best(&part, centre);
-      return grid;
-    };
-    auto frames_of = [&](size_t first, size_t count) {
-      return std::vector<const CalibrationFrame*>(window.begin() + first,
-                                                  window.begin() + first + count);
-    };
-    const std::pair<size_t, size_t> windows[] = {{0, 1}, {0, 2}, {0, 3}, {1, 3}};
-    const int scored_after[] = {1, 2, 3, 4};
-    for (int k = 0; k < 4; ++k) {
-      const auto [first, count] = windows[k];
-      double brute = 0;
-      const RotationGridResult cached =
-          grid_on(frames_of(first, count), start_true_delta, &cache, &brute);
-      const RotationGridResult fresh =
-          grid_on(frames_of(first, count), start_true_delta, nullptr, nullptr);
-      EXPECT_NEAR(cached.score, brute, 1e-9 * brute) << k;
-      EXPECT_EQ(cached.score, fresh.score) << k;
-      EXPECT_EQ(cached.state.T_camera_lidar.matrix(), fresh.state.T_camera_lidar.matrix()) << k;
-      EXPECT_EQ(cached.evaluations, 13 * 13 * 13);
-      EXPECT_EQ(cache.frames_scored(), scored_after[k]) << k;
+      EXPECT_LE(nearest, 0.5 + 1e-9) << v.transpose();
     }
-    grid_on(frames_of(1, 3),
-            Step(start_true_delta, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.01, 0, 0), 0.0),
-            &cache, nullptr);
-    EXPECT_EQ(cache.frames_scored(), 4 + 3);
-    grid_on(frames_of(1, 3),
-            Step(start_true_delta, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.01, 0, 0), 0.002),
-            &cache, nullptr);
-    EXPECT_EQ(cache.frames_scored(), 7 + 3);
-    // A frame with frame 0's key (index, stamp, size) but other points.
-    CalibrationFrame twin = *window[0];
-    for (Eigen::Vector3d& p : twin.points_lidar) p.z() += 0.3;
-    double brute = 0;
-    const RotationGridResult mixed = grid_on({window[0], &twin}, start_true_delta, &cache, &brute);
-    EXPECT_NEAR(mixed.score, brute, 1e-9 * brute);
+    HypothesisLattice too_large;
+    EXPECT_FALSE(HypothesisLattice::Create(lattice_start, wide, LatticeSteps(), &too_large, 1000).ok());
+    const CalibrationFrame& frame = *window[0];
+    ASSERT_FALSE(frame.coarse_map[0].empty());
+    std::vector<float> scores;
+    ScoreFrameOnLattice(frame, lattice, 0.2, 256, &scores);
+    ASSERT_EQ(scores.size(), lattice.size());
+    const int scale = frame.coarse_map_scale;
+    for (size_t h = 0; h < lattice.size(); h += 997) {
+      const CalibrationState state = lattice.State(h);
+      double direct = 0, magnitude = 0;
+      const size_t n = frame.size(), keep = std::min<size_t>(n, 256);
+      for (size_t k = 0; k < keep; ++k) {
+        const size_t i = k * n / keep;
+        Eigen::Vector2d pixel;
+        if (!ProjectFramePoint(frame, state, i, &pixel)) continue;
+        const cv::Mat& map = frame.coarse_map[frame.kinds[i] == EdgeKind::kHorizontal];
+        const double offset = 1.5 - 0.5 * (scale - 1.0) / scale;
+        const int u = std::clamp<int>(std::floor(pixel.x() / scale + offset), 0, map.cols - 1);
+        const int v = std::clamp<int>(std::floor(pixel.y() / scale + offset), 0, map.rows - 1);
+        const double w = frame.kinds[i] == EdgeKind::kHorizontal ? 0.2 : 0.8;
+        direct += w * map.at<float>(v, u);
+        magnitude += w * std::abs(map.at<float>(v, u));
+      }
+      // Float arithmetic: a point on a cell's border may read its neighbour.
+      EXPECT_NEAR(scores[h], direct, 1e-3 * magnitude + 2 * 255.0) << "hypothesis " << h;
+    }
+    LatticeWindow lattice_window(3);
+    std::vector<std::vector<float>> kept;
+    for (size_t f = 0; f < window.size(); ++f) {
+      std::vector<float> frame_scores;
+      ScoreFrameOnLattice(*window[f], lattice, 0.2, 256, &frame_scores);
+      kept.push_back(frame_scores);
+      lattice_window.Add(window[f]->index, std::move(frame_scores));
+    }
+    EXPECT_EQ(lattice_window.frames(), 3);
+    for (size_t h = 0; h < lattice.size(); h += 101) {
+      const double sum = double(kept[3][h]) + kept[4][h] + kept[5][h];
+      EXPECT_NEAR(lattice_window.sums()[h], sum, 1e-3 * (std::abs(sum) + 1)) << h;
+    }
+    // All six frames: the best hypothesis is the truth's lattice neighbour.
+    LatticeWindow all(6);
+    for (std::vector<float>& frame_scores : kept) all.Add(0, std::move(frame_scores));
+    const std::vector<size_t> top = TopHypotheses(lattice, all.sums(), 3);
+    ASSERT_EQ(top.size(), 3u);
+    const CalibrationState best = lattice.State(top[0]);
+    const Eigen::Vector3d rotation_offset_deg =
+        LogSO3(best.T_camera_lidar.linear() * truth.T_camera_lidar.linear().transpose()) * 180 /
+        M_PI;
+    std::printf("lattice: best hypothesis off the truth by (%.2f, %.2f, %.2f) deg about camera x, "
+                "y, z, δ %+.1f ms\n",
+                rotation_offset_deg.x(), rotation_offset_deg.y(), rotation_offset_deg.z(),
+                1000 * (best.time_offset_s - truth.time_offset_s));
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_LE(std::abs(rotation_offset_deg[k]), LatticeSteps().rotation_deg[k]) << k;
+    }
+    EXPECT_LE(std::abs(best.time_offset_s - truth.time_offset_s), LatticeSteps().time_offset_s);
+    // Distinct rotations: no two within one step of each other on every axis.
+    for (size_t a = 0; a < top.size(); ++a) {
+      for (size_t b = a + 1; b < top.size(); ++b) {
+        const Eigen::Vector3i gap = lattice.RotationCell(lattice.RotationOf(top[a])) -
+                                    lattice.RotationCell(lattice.RotationOf(top[b]));
+        EXPECT_GE(gap.cwiseAbs().maxCoeff(), 2);
+      }
+    }
   }
 
   // Refinement over eight frames from a small error: closer to the truth, with a covariance.
@@ -657,9 +625,8 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
               profile.best_s, profile.second_peak_ratio);
   EXPECT_NEAR(profile.best_s, 0.03, 0.015);
 
-  // The online calibrator over the drive from ±2° / ±5 cm / δ0 = 0, with the defaults but for
-  // the refinement window: the acquisition ends only when the grid agrees with the estimate on a
-  // full refinement window, which needs a drive longer than these 12 frames at the default 20.
+  // The online calibrator over the drive from ±2° / ±5 cm / δ0 30 ms off, with the defaults but
+  // for the refinement window (these are 12 frames).
   OnlineCalibratorOptions online_options;
   online_options.refine_frames = 10;
   const CalibrationState online_start = Step(truth, Eigen::Vector3d(-2, 2, -2) * M_PI / 180.0,
@@ -687,17 +654,17 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     SCOPED_TRACE("frame " + std::to_string(report.frame) + ": " + report.reason);
     EXPECT_EQ(folds_read(dropping), 0u);
     EXPECT_GT(count_folds(dropping.HealthWindow()), 0u);
-    // From then on every window is read at tracking_horizontal_weight, the health's too.
-    ASSERT_NE(dropping_options.tracking_horizontal_weight, dropping.options().horizontal_weight);
-    EXPECT_EQ(dropping.ScoreOptionsInUse().horizontal_weight,
-              dropping_options.tracking_horizontal_weight);
-    EXPECT_EQ(dropping.RefineOptionsInUse().horizontal_weight,
-              dropping_options.tracking_horizontal_weight);
+    // From then on every window is read at kFoldFreeHorizontalWeight, the health's too, and
+    // the refinement at the acquired loss.
+    ASSERT_NE(kFoldFreeHorizontalWeight, dropping.options().horizontal_weight);
+    EXPECT_EQ(dropping.ScoreOptionsInUse().horizontal_weight, kFoldFreeHorizontalWeight);
+    EXPECT_EQ(dropping.RefineOptionsInUse().horizontal_weight, kFoldFreeHorizontalWeight);
+    EXPECT_EQ(dropping.RefineOptionsInUse().loss, kAcquiredLoss);
     WindowScorer health_scorer(dropping.HealthWindow(), dropping.ScoreOptionsInUse());
     EXPECT_EQ(report.health, HealthScore(&health_scorer, dropping.state()));
     const bool first = dropped_frames++ == 0;
     EXPECT_EQ(report.reason.find("folds dropped, a full step") == 0,
-              first && report.accepted && !report.coarse_search);
+              first && report.accepted && !report.from_hypotheses);
     if (first) {
       EXPECT_TRUE(report.ran_update());
     } else if (report.health_before >= dropping_options.lost_health) {
@@ -729,16 +696,11 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
       EXPECT_TRUE(calibrator.state().T_camera_lidar.isApprox(before.T_camera_lidar));
     }
   }
-  // The acquisition's grid ran with the calibrator's cache: some frames were scored, fewer than
-  // a grid over the whole window on every frame after the window filled would score.
-  int uncached_bound = 0;
-  for (int k = online_options.window_frames - 1; k < static_cast<int>(frames.size()); ++k) {
-    uncached_bound += std::min(k + 1, online_options.refine_frames);
-  }
-  std::printf("grid cache: %d frames scored (at most %d without it)\n",
-              calibrator.grid_cache().frames_scored(), uncached_bound);
-  EXPECT_GT(calibrator.grid_cache().frames_scored(), 0);
-  EXPECT_LT(calibrator.grid_cache().frames_scored(), uncached_bound);
+  // The acquisition scored each frame once over its lattice while it acquired: its window holds
+  // every frame that arrived until then (up to refine_frames).
+  EXPECT_GT(calibrator.acquisition().frames(), online_options.window_frames - 1);
+  EXPECT_LE(calibrator.acquisition().frames(), online_options.refine_frames);
+  EXPECT_TRUE(calibrator.acquisition().dominance().dominant);
   EXPECT_GT(folds_while_acquiring, 0u);
   {
     auto later = std::make_shared<CalibrationFrame>(*frames.back());  // a tracking frame
@@ -756,24 +718,6 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
   EXPECT_LT(online_error.translation_norm_m, 0.12);
   EXPECT_LT(std::abs(online_error.time_offset_s), 0.02);
   EXPECT_GT(last.health, 0.8);
-
-  // With the rotation grid (the default) the search never reads the coarse pyramid levels, so
-  // `stcalib calibrate` leaves them out of its frames (ReadsCoarseLevels): the same run on frames
-  // that carry only the finest map ends bit for bit where this one did.
-  ASSERT_FALSE(online_options.ReadsCoarseLevels());
-  ASSERT_GT(frames[0]->score_maps[0].size(), 1u);
-  OnlineCalibrator finest_only(online_options,
-                               Step(truth, Eigen::Vector3d(-2, 2, -2) * M_PI / 180.0,
-                                    Eigen::Vector3d(0.05, -0.05, 0.05), -0.03));
-  for (const auto& frame : frames) {
-    auto stripped = std::make_shared<CalibrationFrame>(*frame);
-    for (std::vector<cv::Mat>& levels : stripped->score_maps)
-      levels.erase(levels.begin(), levels.end() - 1);
-    finest_only.AddFrame(stripped);
-  }
-  EXPECT_TRUE(finest_only.state().T_camera_lidar.matrix() ==
-              calibrator.state().T_camera_lidar.matrix());
-  EXPECT_EQ(finest_only.state().time_offset_s, calibrator.state().time_offset_s);
 
   // Tracking cadence (tracking_update_every, default 3): once acquired, a healthy frame runs the
   // search and refinement on every third frame only; the frames between join the window and
@@ -845,7 +789,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     if (k == frames.size() - 3) {
       // Lost after the acquisition: the rotation jumps to the chosen candidate, the translation
       // and δ move by tracking_gain only.
-      EXPECT_TRUE(r.coarse_search);
+      EXPECT_TRUE(r.from_hypotheses);
       EXPECT_FALSE(r.acquiring);
       ASSERT_EQ(r.reason.rfind("refined", 0), 0u) << r.reason;
       const CalibrationState chosen =
@@ -901,7 +845,7 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
                 1000 * pair.time_offset_std_s, 100 * pair.forward_std_m, pair.correlation);
     EXPECT_TRUE(pair.measured);
     EXPECT_FALSE(pair.separated);
-    EXPECT_GT(pair.forward_std_m, online_options.polish_forward_std_m);
+    EXPECT_GT(pair.forward_std_m, kPolishForwardStdM);
     EXPECT_LT(pair.correlation, -0.9);
     EXPECT_LE(std::abs(ComputeCalibrationError(calibrator.state(), truth).time_offset_s),
               3 * pair.time_offset_std_s);

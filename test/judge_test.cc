@@ -2,7 +2,10 @@
 // (NextPhase, core/online/online_calibrator.h), each from hand-made inputs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "core/online/convergence.h"
 #include "core/online/online_calibrator.h"
@@ -22,7 +25,6 @@ ConvergenceEvidence Passing() {
   e.last_reason = "refined";
   e.window_frames = 3;
   e.acquiring = false;
-  e.acquisition_frames = 20;
   e.rotation_moved_deg = 2.0;
   e.rotation_bound_deg = 5.0;
   e.time_offset_s = 0.03;
@@ -93,7 +95,7 @@ TEST(Judge, EachRuleRefusesItsOwnFailure) {
 
   e = Passing();
   e.acquiring = true;
-  EXPECT_EQ(FirstFailure(e), "acquired");
+  EXPECT_EQ(FirstFailure(e), "one_hypothesis_dominates");
 
   e = Passing();
   e.rotation_moved_deg = 4.6;  // within the 0.5° margin of the 5° bound
@@ -182,25 +184,80 @@ TEST(Judge, ListsEveryFailingRuleAndGivesTheFirstAsTheReason) {
   EXPECT_EQ(FirstFailure(e), "observable");
 }
 
-// A run still acquiring at its end claims only when its last rotation grid agreed with the
-// estimate over every frame it used, and over at least 8: a ten-frame drive can claim, three
-// frames cannot, and a grid that agreed on fewer frames than the run had does not count.
-TEST(Judge, AShortRunClaimsWhenItsGridAgreedOnAllItsFrames) {
+// Hypotheses' per-frame fine scores, made by hand: `base` per frame for the best, the rivals
+// below it by `gap` on every frame but the frames listed in `wins`, where they beat it by `gap`.
+std::vector<double> Scores(int frames, double base, double gap, std::vector<int> wins = {}) {
+  std::vector<double> scores;
+  for (int f = 0; f < frames; ++f) {
+    const bool win = std::find(wins.begin(), wins.end(), f) != wins.end();
+    scores.push_back(base + (win ? gap : -gap) + 0.1 * (f % 3));
+  }
+  return scores;
+}
+
+CalibrationState Turned(double deg) {
+  return Step(CalibrationState(), Eigen::Vector3d(0, 0, deg) * M_PI / 180.0,
+              Eigen::Vector3d::Zero(), 0.0);
+}
+
+// One hypothesis dominates when it has been compared over enough frames and every rival not on
+// its peak trails it by at least min_t standard errors of the per-frame gain (frames that share
+// sweeps counted once); the best is the highest sum wherever it is listed.
+TEST(Dominance, OneHypothesisDominatesWhenEveryRivalTrailsOnTheFramesSeen) {
+  const DominanceOptions options;
+  ASSERT_EQ(options.min_frames, 6);
+  // Nine frames: the rival 3° away trails by 20 on every frame, the one 1° away is on the peak.
+  const std::vector<CalibrationState> states = {Turned(3), Turned(0), Turned(1)};
+  std::vector<std::vector<double>> scores = {Scores(9, 100, 20), Scores(9, 100, 0),
+                                             Scores(9, 100, 5)};
+  Dominance d = JudgeDominance(scores, states, 3, options);
+  EXPECT_EQ(d.best, 1);
+  EXPECT_EQ(d.frames, 9);
+  EXPECT_TRUE(d.dominant) << d.detail;
+  EXPECT_NEAR(d.rivals[0].rotation_deg, 3.0, 1e-9);
+  EXPECT_FALSE(d.rivals[0].merged);
+  EXPECT_GT(d.rivals[0].t_statistic, options.min_t);
+  EXPECT_NEAR(d.rivals[0].score_share, 20.0 / 100.1, 1e-3);
+  EXPECT_TRUE(d.rivals[2].merged);  // within merge_deg: the same peak, whatever its margin
+
+  // Five frames are too few, however clear.
+  scores = {Scores(5, 100, 20), Scores(5, 100, 0), Scores(5, 100, 5)};
+  d = JudgeDominance(scores, states, 3, options);
+  EXPECT_FALSE(d.dominant);
+  EXPECT_EQ(d.detail, "5 frames seen, 6 needed");
+
+  // The far rival beats the best on 4 of 9 frames: its deficit is within the noise.
+  scores = {Scores(9, 100, 20, {0, 2, 4, 6}), Scores(9, 100, 0), Scores(9, 100, 5)};
+  d = JudgeDominance(scores, states, 3, options);
+  EXPECT_EQ(d.best, 1);
+  EXPECT_FALSE(d.dominant);
+  EXPECT_LT(d.rivals[0].t_statistic, options.min_t);
+  EXPECT_NE(d.detail.find("1 rival(s)"), std::string::npos) << d.detail;
+  EXPECT_NE(DescribeRivals(d).find("3.00 deg"), std::string::npos) << DescribeRivals(d);
+
+  // The same gains with frames that each share sweeps with two others: a third of the evidence.
+  scores = {Scores(9, 100, 20, {0}), Scores(9, 100, 0), Scores(9, 100, 5)};
+  const double t_independent = JudgeDominance(scores, states, 1, options).rivals[0].t_statistic;
+  const double t_shared = JudgeDominance(scores, states, 3, options).rivals[0].t_statistic;
+  EXPECT_NEAR(t_shared, t_independent / std::sqrt(3.0), 1e-9);
+
+  // No hypothesis: nothing dominates.
+  EXPECT_FALSE(JudgeDominance({}, {}, 1, options).dominant);
+}
+
+// A run still acquiring at its end is refused by the dominance rule, naming its runners-up.
+TEST(Judge, AStillAcquiringRunNamesItsRunnersUp) {
   ConvergenceEvidence e = Passing();
   e.acquiring = true;
-  e.used_frames = 10;
-  e.grid_agreement_frames = 10;
-  EXPECT_EQ(FirstFailure(e), "");
-  e.grid_agreement_frames = 0;  // the last grid did not agree
-  EXPECT_EQ(FirstFailure(e), "acquired");
-  e.used_frames = 30;  // 30 frames: a full window of 20 is needed
-  e.grid_agreement_frames = 19;
-  EXPECT_EQ(FirstFailure(e), "acquired");
-  e.grid_agreement_frames = 20;
-  EXPECT_EQ(FirstFailure(e), "");
-  e.used_frames = 5;  // too few frames however the grid agreed
-  e.grid_agreement_frames = 5;
-  EXPECT_EQ(FirstFailure(e), "acquired");
+  e.dominance = JudgeDominance({Scores(9, 100, 0), Scores(9, 100, 20, {0, 2, 4, 6})},
+                               {Turned(0), Turned(4)}, 3);
+  const Judgement j = Judge(e, ConvergenceOptions());
+  EXPECT_FALSE(j.converged);
+  EXPECT_NE(j.reason.find("still acquiring: no hypothesis dominates"), std::string::npos)
+      << j.reason;
+  EXPECT_NE(j.reason.find("4.00 deg"), std::string::npos) << j.reason;
+  e.acquiring = false;
+  EXPECT_TRUE(Judge(e, ConvergenceOptions()).converged);
 }
 
 // The jackknife's std: sqrt((n − 1) / n · Σ (θ_i − θ̄)²) per component.
@@ -219,29 +276,22 @@ TEST(Jackknife, StdOfLeaveOneOutEstimates) {
   EXPECT_NEAR(four.x(), 3.0, 1e-12);
 }
 
-PhaseInputs Inputs(int window_size, bool grid_agreed, double health, bool acquisition = true) {
+PhaseInputs Inputs(int window_size, bool dominant, double health) {
   PhaseInputs in;
   in.window_size = window_size;
   in.window_frames = 3;
-  in.acquisition = acquisition;
-  in.grid_agreed = grid_agreed;
+  in.dominant = dominant;
   in.health = health;
   in.lost_health = 0.9;
   return in;
 }
 
-TEST(Phase, FillingThenAcquiringUntilTheGridAgrees) {
+TEST(Phase, FillingThenAcquiringUntilOneHypothesisDominates) {
   EXPECT_EQ(NextPhase(Phase::kFilling, Inputs(2, false, 1.0)), Phase::kFilling);
   EXPECT_EQ(NextPhase(Phase::kFilling, Inputs(3, false, 1.0)), Phase::kAcquiring);
   EXPECT_EQ(NextPhase(Phase::kAcquiring, Inputs(3, false, 1.0)), Phase::kAcquiring);
   EXPECT_EQ(NextPhase(Phase::kAcquiring, Inputs(3, true, 0.95)), Phase::kTracking);
   EXPECT_EQ(NextPhase(Phase::kAcquiring, Inputs(3, true, 0.5)), Phase::kLost);
-}
-
-TEST(Phase, WithoutAnAcquisitionFillingGoesStraightToTheHealthsPhase) {
-  EXPECT_EQ(NextPhase(Phase::kFilling, Inputs(2, false, 1.0, false)), Phase::kFilling);
-  EXPECT_EQ(NextPhase(Phase::kFilling, Inputs(3, false, 1.0, false)), Phase::kTracking);
-  EXPECT_EQ(NextPhase(Phase::kFilling, Inputs(3, false, 0.2, false)), Phase::kLost);
 }
 
 TEST(Phase, TrackingAndLostFollowTheHealthAndNeverGoBack) {

@@ -33,6 +33,13 @@ Dominance JudgeDominance(const std::vector<std::vector<double>>& frame_scores,
   const int n = out.frames;
   // Frames sharing a sweep through their local maps are one observation, not several.
   const double effective_n = std::max(1.0, static_cast<double>(n) / std::max(1, shared_sweep_frames));
+  // Each frame's gains relative to that frame's scale (the mean |score| of the hypotheses on it):
+  // frames with many edges score higher and would otherwise weigh more in the spread.
+  std::vector<double> scale(n, 0.0);
+  for (int f = 0; f < n; ++f) {
+    for (const std::vector<double>& scores : frame_scores) scale[f] += std::abs(scores[f]);
+    scale[f] = std::max(scale[f] / states.size(), 1e-9);
+  }
   int standing = 0;
   for (size_t k = 0; k < states.size(); ++k) {
     if (static_cast<int>(k) == out.best) continue;
@@ -44,10 +51,10 @@ Dominance JudgeDominance(const std::vector<std::vector<double>>& frame_scores,
                                             : 0.0;
     rival.merged = rival.rotation_deg < options.merge_deg;
     double mean = 0, square = 0;
-    for (int f = 0; f < n; ++f) mean += frame_scores[out.best][f] - frame_scores[k][f];
+    for (int f = 0; f < n; ++f) mean += (frame_scores[out.best][f] - frame_scores[k][f]) / scale[f];
     mean /= std::max(1, n);
     for (int f = 0; f < n; ++f) {
-      const double d = frame_scores[out.best][f] - frame_scores[k][f] - mean;
+      const double d = (frame_scores[out.best][f] - frame_scores[k][f]) / scale[f] - mean;
       square += d * d;
     }
     const double sd = n > 1 ? std::sqrt(square / (n - 1)) : 0.0;
@@ -103,6 +110,7 @@ void Acquisition::AddFrame(const CalibrationFrame& frame, double horizontal_weig
 }
 
 const std::vector<Hypothesis>& Acquisition::Update(WindowScorer* search, WindowScorer* judge,
+                                                   const CalibrationState& incumbent,
                                                    const CalibrationState& anchor,
                                                    const AdaptiveGridSearchOptions& options,
                                                    int shared_sweep_frames, int* evaluations) {
@@ -114,14 +122,21 @@ const std::vector<Hypothesis>& Acquisition::Update(WindowScorer* search, WindowS
   refine.search_translation = false;
   refine.first_level = search->num_levels() - 1;
   std::vector<Hypothesis> next;
-  for (size_t h : top) {
+  for (size_t k = 0; k <= top.size(); ++k) {
     Hypothesis hypothesis;
-    hypothesis.lattice_index = h;
-    hypothesis.lattice_score = window_.sums()[h];
-    hypothesis.state = lattice_.State(h);
-    for (const Hypothesis& carried : hypotheses_) {
-      if (lattice_.RotationOf(carried.lattice_index) == lattice_.RotationOf(h)) {
-        hypothesis.state = carried.state;
+    if (k == top.size()) {  // the estimate, as one hypothesis among the others
+      hypothesis.incumbent = true;
+      hypothesis.state = incumbent;
+    } else {
+      const size_t h = top[k];
+      hypothesis.lattice_index = h;
+      hypothesis.lattice_score = window_.sums()[h];
+      hypothesis.state = lattice_.State(h);
+      for (const Hypothesis& carried : hypotheses_) {
+        if (!carried.incumbent &&
+            lattice_.RotationOf(carried.lattice_index) == lattice_.RotationOf(h)) {
+          hypothesis.state = carried.state;
+        }
       }
     }
     const SearchResult result = AdaptiveGridSearch(search, hypothesis.state, anchor, refine);
@@ -131,7 +146,8 @@ const std::vector<Hypothesis>& Acquisition::Update(WindowScorer* search, WindowS
       hypothesis.frame_scores.push_back(judge->EvaluateFrame(f, hypothesis.state, -1).score);
     }
     *evaluations += static_cast<int>(judge->num_frames());
-    if (VLOG_IS_ON(2)) {
+    if (VLOG_IS_ON(2) && !hypothesis.incumbent) {
+      const size_t h = hypothesis.lattice_index;
       double fine = 0;
       for (double v : hypothesis.frame_scores) fine += v;
       const Eigen::Vector3d r = lattice_.RotationOffsetRad(h) * 180 / M_PI;
@@ -159,6 +175,15 @@ const std::vector<Hypothesis>& Acquisition::Update(WindowScorer* search, WindowS
   }
   hypotheses_ = std::move(next);
   return hypotheses_;
+}
+
+double Acquisition::LeadOverIncumbent() const {
+  for (size_t k = 0; k < hypotheses_.size(); ++k) {
+    if (!hypotheses_[k].incumbent) continue;
+    if (static_cast<int>(k) == dominance_.best || dominance_.rivals[k].merged) return 0;
+    return dominance_.rivals[k].t_statistic;
+  }
+  return 0;
 }
 
 }  // namespace stcalib

@@ -13,6 +13,7 @@ namespace stcalib {
 // A hypothesis the acquisition carries from frame to frame (docs/method.md §7): a peak of the
 // lattice's window score, refined on the fine maps.
 struct Hypothesis {
+  bool incumbent = false;       ///< refined from the estimate itself, not from a lattice point
   size_t lattice_index = 0;     ///< its lattice point (the best δ and translation of its rotation)
   double lattice_score = 0;     ///< the window's coarse score there
   CalibrationState state;       ///< refined on the fine maps (rotation and δ)
@@ -25,8 +26,9 @@ struct RivalMargin {
   double time_offset_s = 0;  ///< its δ − the best's [s]
   // (best − rival) ÷ best, of the fine scores summed over the frames.
   double score_share = 0;
-  // The mean per-frame score gain of the best over the rival ÷ its standard error, with the
-  // frames that share sweeps counted once: how many standard errors the best is ahead.
+  // The mean per-frame score gain of the best over the rival (each frame's gain relative to the
+  // mean |score| of the hypotheses on it) ÷ its standard error, with the frames that share sweeps
+  // counted once: how many standard errors the best is ahead.
   double t_statistic = 0;
   bool merged = false;  ///< refined onto the best's peak: no rival
 };
@@ -45,9 +47,9 @@ struct DominanceOptions {
   // A rival refined to within this of the best is on the same peak (the fine score's peak is
   // about ±1° wide, docs/method.md §10) [deg].
   double merge_deg = 1.5;
-  // Every rival must trail the best by this many standard errors (one-sided, about 0.6 %
+  // Every rival must trail the best by this many standard errors (one-sided, about 2.3 %
   // false-alarm rate for independent frames).
-  double min_t = 2.5;
+  double min_t = 2.0;
 };
 // `frame_scores[k][f]`: hypothesis k's fine score on frame f (every hypothesis over the same
 // frames); `states[k]` its refined state; `shared_sweep_frames`: frames that share each sweep
@@ -71,14 +73,18 @@ class Acquisition {
                 double horizontal_weight, const StartUncertainty& span);
   // Scores `frame` once over the lattice and adds it to the window.
   void AddFrame(const CalibrationFrame& frame, double horizontal_weight);
-  // The best kHypotheses peaks of the window's score, each refined in rotation and δ on
-  // `search`'s fine maps (from the state it had on the previous frame when it is the same
-  // lattice rotation), and scored frame by frame on `judge`'s frames; then the dominance among
-  // them. Best first.
+  // The best kHypotheses peaks of the window's score and the `incumbent` (the estimate), each
+  // refined in rotation and δ on `search`'s fine maps (a lattice peak from the state it had on
+  // the previous frame when it is the same lattice rotation), and scored frame by frame on
+  // `judge`'s frames; then the dominance among them. Best first.
   const std::vector<Hypothesis>& Update(WindowScorer* search, WindowScorer* judge,
+                                        const CalibrationState& incumbent,
                                         const CalibrationState& anchor,
                                         const AdaptiveGridSearchOptions& options,
                                         int shared_sweep_frames, int* evaluations);
+  // How many standard errors the best hypothesis leads the incumbent by (0 when the incumbent is
+  // the best or on its peak).
+  double LeadOverIncumbent() const;
   const std::vector<Hypothesis>& hypotheses() const { return hypotheses_; }
   const Dominance& dominance() const { return dominance_; }
   const HypothesisLattice& lattice() const { return lattice_; }

@@ -36,7 +36,6 @@ struct FrameSourceOptions {
   std::optional<Rigid3d> view_T_camera_lidar;
 
   FrameSourceOptions() {
-    image.pyramid_basins_px = {60, 30};
     // Calibration wants precision over recall from the dynamic filter: a moving point left in
     // costs little under the robust loss, but a static structure removed because its occlusion
     // boundaries moved between viewpoints takes the nearest, most informative edges with it.

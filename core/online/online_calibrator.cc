@@ -21,6 +21,11 @@ namespace {
 // Wider, on the shared drive the fine score's side peaks 4-5° away outscore the estimate's over a
 // fold-free window (docs/tuning.md#lost-span).
 constexpr StartUncertainty kLostSpan{3.0, 0.05, 0.02};
+// While acquiring, the estimate leaves its own peak for the best hypothesis only when that leads
+// it by this many standard errors (JudgeDominance's t): a few frames' scores are ambiguous, and a
+// jump to a side peak costs the frames until the next jump back.
+// Measured: docs/tuning.md#lattice-steps
+constexpr double kJumpStandardErrors = 2.0;
 
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -125,21 +130,19 @@ OnlineCalibratorOptions WithStartUncertainty(const OnlineCalibratorOptions& opti
                                              double initial_time_offset_s) {
   OnlineCalibratorOptions out = options;
   const StartUncertainty& u = options.start_uncertainty;
-  // The bounds are norms over the three axes; the lattice reaches half a step past its span.
+  // The bounds are norms over the three axes.
   constexpr double kBasinDeg = 1.0;  // the band-pass score's peak, docs/method.md §10
   const double kAxes = std::sqrt(3.0);
-  const LatticeSteps steps;
   out.search.max_rotation_offset_deg =
       std::max(out.search.max_rotation_offset_deg, kAxes * u.rotation_deg + kBasinDeg);
   out.search.max_translation_offset_m =
-      std::max(out.search.max_translation_offset_m, kAxes * (u.translation_m + steps.translation_m.maxCoeff() / 2));
+      std::max(out.search.max_translation_offset_m, kAxes * u.translation_m + 0.05);
   out.search.translation_prior_sigma_m = std::max(out.search.translation_prior_sigma_m, u.translation_m);
   out.refine.prior_sigma_translation_m = std::max(out.refine.prior_sigma_translation_m, u.translation_m);
   out.search.time_offset_prior_sigma_s = std::max(out.search.time_offset_prior_sigma_s, u.time_offset_s);
   out.refine.prior_sigma_time_s = std::max(out.refine.prior_sigma_time_s, u.time_offset_s);
-  out.time_offset_bound_s = std::max(out.time_offset_bound_s, std::abs(initial_time_offset_s) +
-                                                                   u.time_offset_s +
-                                                                   steps.time_offset_s / 2);
+  out.time_offset_bound_s =
+      std::max(out.time_offset_bound_s, std::abs(initial_time_offset_s) + u.time_offset_s);
   return out;
 }
 
@@ -272,13 +275,13 @@ FrameReport OnlineCalibrator::AddFrame(std::shared_ptr<const CalibrationFrame> f
   const std::string wait = WhyNoUpdate(window_size, update_now || refit, report.health_before);
   if (!wait.empty()) return KeepEstimate(report, wait);
   // The paper's update: search (from the best hypothesis while acquiring or lost), refine, choose.
-  Update(&scorer, refit, &report);
+  const bool compared_hypotheses = Update(&scorer, refit, &report);
   MeasureEstimate(&scorer, health_scorer, report.accepted, &report);
   RememberIfHealthy(report.health, window_size);
   // The acquisition ends when one hypothesis dominates and the estimate sits on its peak.
   const std::vector<Hypothesis>& hypotheses = acquisition_.hypotheses();
   const bool dominant =
-      report.from_hypotheses && acquisition_.dominance().dominant && !hypotheses.empty() &&
+      compared_hypotheses && acquisition_.dominance().dominant && !hypotheses.empty() &&
       RotationErrorDeg(hypotheses.front().state.T_camera_lidar.linear(),
                        state_.T_camera_lidar.linear()) < DominanceOptions().merge_deg;
   UpdatePhase(window_size, report.health, dominant);
@@ -333,16 +336,16 @@ std::string OnlineCalibrator::WhyNoUpdate(int window_size, bool update_now, doub
   return "";
 }
 
-void OnlineCalibrator::Update(WindowScorer* scorer, bool full_step, FrameReport* report) {
-  // From the lattice's hypotheses while acquiring or lost (or when the estimate's health says it
-  // is lost now), else from the estimate.
-  report->from_hypotheses = phase_ == Phase::kAcquiring || phase_ == Phase::kLost ||
-                            report->health_before < options_.lost_health;
+bool OnlineCalibrator::Update(WindowScorer* scorer, bool full_step, FrameReport* report) {
+  // The lattice's hypotheses are read while acquiring or lost (or when the estimate's health says
+  // it is lost now).
+  const bool read_hypotheses = phase_ == Phase::kAcquiring || phase_ == Phase::kLost ||
+                               report->health_before < options_.lost_health;
   // The refinement's frames, every point of their maps: the hypotheses' and candidates' judge.
   WindowScorer long_scorer(LatestFrames(options_.refine_frames), ScoreOptionsInUse());
   AdaptiveGridSearchOptions search_options = options_.search;
   search_options.first_level = scorer->num_levels() - 1;
-  Search(scorer, &long_scorer, search_options, report);
+  Search(scorer, &long_scorer, search_options, read_hypotheses, report);
   const auto start = std::chrono::steady_clock::now();
   report->refine = Refine(RefineWindow(), report->search.state, report->search.state, anchor_,
                           RefineOptionsInUse());
@@ -350,6 +353,7 @@ void OnlineCalibrator::Update(WindowScorer* scorer, bool full_step, FrameReport*
   Choose(Candidates(report), &long_scorer, search_options, full_step, report);
   refit_pending_ = false;
   state_ = report->after;
+  return read_hypotheses;
 }
 
 void OnlineCalibrator::UpdatePhase(int window_size, double health, bool dominant) {
@@ -490,26 +494,32 @@ void OnlineCalibrator::MeasureEstimate(WindowScorer* scorer, WindowScorer* healt
 
 void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
                               const AdaptiveGridSearchOptions& search_options,
-                              FrameReport* report) {
+                              bool read_hypotheses, FrameReport* report) {
   const auto start = std::chrono::steady_clock::now();
   CalibrationState search_start = state_;
   int evaluations = 0;
-  if (report->from_hypotheses) {
+  if (read_hypotheses) {
     // The lattice's best peaks, refined on the fine maps and compared frame by frame on the
     // refinement's frames; the search starts from the best.
-    const std::vector<Hypothesis>& hypotheses = acquisition_.Update(
-        scorer, long_scorer, anchor_, search_options, SharedSweepFrames(), &evaluations);
+    const std::vector<Hypothesis>& hypotheses =
+        acquisition_.Update(scorer, long_scorer, state_, anchor_, search_options,
+                            SharedSweepFrames(), &evaluations);
     // On the estimate's own peak the search refines the estimate; elsewhere it starts afresh
-    // from the best hypothesis: while acquiring, the estimate follows the best; once acquired (a
-    // lost estimate), it leaves the last healthy estimate's peak only for a hypothesis that
-    // dominates the others.
+    // from the best hypothesis: while acquiring, once that leads the estimate's own by
+    // kJumpStandardErrors; once acquired (a lost estimate), it leaves the last healthy
+    // estimate's peak only for a hypothesis that dominates the others.
     const bool acquired = phase_ == Phase::kTracking || phase_ == Phase::kLost;
     if (acquired && has_last_healthy_) search_start = last_healthy_;
-    if (!hypotheses.empty() && (!acquired || acquisition_.dominance().dominant) &&
+    const bool leads = acquired ? acquisition_.dominance().dominant
+                                : acquisition_.LeadOverIncumbent() >= kJumpStandardErrors;
+    if (!hypotheses.empty() && leads &&
         RotationErrorDeg(hypotheses.front().state.T_camera_lidar.linear(),
                          search_start.T_camera_lidar.linear()) >= DominanceOptions().merge_deg) {
       search_start = hypotheses.front().state;
     }
+    report->from_hypotheses =
+        search_start.T_camera_lidar.matrix() != state_.T_camera_lidar.matrix() ||
+        search_start.time_offset_s != state_.time_offset_s;
     VLOG(1) << "frame " << report->frame << ": best hypothesis "
             << RotationErrorDeg(search_start.T_camera_lidar.linear(),
                                 state_.T_camera_lidar.linear())

@@ -146,7 +146,8 @@ struct FrameReport {
   double gray_rate_before = 0, gray_rate_after = 0;  ///< on the plain IDT
   double health_before = 0;                          ///< docs/method.md §7, at `before`
   double health = 0;                                 ///< docs/method.md §7, at `after`
-  // The update started from the lattice's hypotheses (acquiring or lost) and jumps to its choice.
+  // The search started away from the estimate, from the best hypothesis (acquiring or lost) or,
+  // lost, from the last healthy estimate: the update jumps to its choice.
   bool from_hypotheses = false;
   bool acquiring = false;  ///< the calibrator was still acquiring when the frame arrived
   SearchResult search;
@@ -266,13 +267,15 @@ class OnlineCalibrator {
   // `update_now`), or empty when it does; counts the frames between tracking updates.
   std::string WhyNoUpdate(int window_size, bool update_now, double health_before);
   // Search, refinement and choice on `scorer`'s window (the search window); moves the estimate
-  // to report->after (by a full step when `full_step`).
-  void Update(WindowScorer* scorer, bool full_step, FrameReport* report);
+  // to report->after (by a full step when `full_step`). True when it compared the lattice's
+  // hypotheses (acquiring or lost).
+  bool Update(WindowScorer* scorer, bool full_step, FrameReport* report);
   std::vector<const CalibrationFrame*> RefineWindow() const;  ///< latest refine_frames
   // While acquiring or lost: the lattice's hypotheses refined and judged; the search starts from
   // the best. Otherwise the search starts from the estimate. Fills report->search and search_ms.
   void Search(WindowScorer* scorer, WindowScorer* long_scorer,
-              const AdaptiveGridSearchOptions& search_options, FrameReport* report);
+              const AdaptiveGridSearchOptions& search_options, bool read_hypotheses,
+              FrameReport* report);
   // The refined estimate and the search result, the axes the refinement found unobservable held.
   std::vector<Candidate> Candidates(FrameReport* report) const;
   // The best candidate within the bounds that scores at least as well as the estimate on the
