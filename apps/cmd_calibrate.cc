@@ -479,7 +479,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   if (!status.ok()) return fail(status);
 
   std::string csv =
-      "frame,accepted,from_hypotheses,points,gray_rate,health,roll_deg,pitch_deg,yaw_deg,x_m,y_m,z_m,"
+      "frame,accepted,from_hypotheses,points,gray_rate,health,roll_deg,pitch_deg,yaw_deg,x_m,y_m,z_"
+      "m,"
       "time_offset_s,rotation_error_deg,translation_error_m,time_offset_error_s,search_ms,refine_"
       "ms,phase,reason\n";
   std::vector<double> xs, rot_err, trans_err_cm, dt_ms, roll_e, pitch_e, yaw_e;

@@ -246,8 +246,7 @@ TEST(OnlineCalibrator, FoldsInTheWindowFollowTheOption) {
     const FrameReport r = calibrator.AddFrame(FrameWithAFold(0, 1.0));
     EXPECT_NE(r.reason.find("too few LiDAR edge points"), std::string::npos) << r.reason;
     ASSERT_EQ(calibrator.RecentFrames().size(), 1u);
-    EXPECT_EQ(calibrator.RecentFrames()[0]->size(), points)
-        << FoldsName(folds);
+    EXPECT_EQ(calibrator.RecentFrames()[0]->size(), points) << FoldsName(folds);
     EXPECT_EQ(calibrator.SearchWindow()[0], calibrator.RecentFrames()[0].get());
   }
   OnlineCalibratorOptions::Folds parsed = OnlineCalibratorOptions::Folds::kKeep;
@@ -474,8 +473,8 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
       WindowScorer variant_scorer(window, variant);
       const CalibrationState near_start =
           Step(truth, Eigen::Vector3d(0.6, -0.6, 0.6) * M_PI / 180.0, Eigen::Vector3d::Zero(), 0);
-      const SearchResult result = AdaptiveGridSearch(&variant_scorer, near_start, near_start,
-                                                     AdaptiveGridSearchOptions());
+      const SearchResult result =
+          AdaptiveGridSearch(&variant_scorer, near_start, near_start, AdaptiveGridSearchOptions());
       const CalibrationError error = ComputeCalibrationError(result.state, truth);
       std::printf("search from 1.04 deg, w %.2f, %d points: %s\n", w, points,
                   ToString(error).c_str());
@@ -505,19 +504,22 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     // Every rotation offset within the span lies within half a step of a lattice rotation on
     // each axis (corners and a few points inside).
     const Eigen::Vector3d steps_deg = LatticeSteps().rotation_deg;
-    for (const Eigen::Vector3d& v : std::vector<Eigen::Vector3d>{Eigen::Vector3d(5, 5, 5), Eigen::Vector3d(-5, 4.6, -0.3),
-                                     Eigen::Vector3d(1.1, -2.9, 4.99), Eigen::Vector3d(0, 0, 0)}) {
+    for (const Eigen::Vector3d& v :
+         std::vector<Eigen::Vector3d>{Eigen::Vector3d(5, 5, 5), Eigen::Vector3d(-5, 4.6, -0.3),
+                                      Eigen::Vector3d(1.1, -2.9, 4.99), Eigen::Vector3d(0, 0, 0)}) {
       double nearest = std::numeric_limits<double>::infinity();
       for (size_t r = 0; r < lattice.num_rotations(); ++r) {
         const Eigen::Vector3d offset_deg =
             lattice.RotationOffsetRad(r * lattice.num_time_offsets() * lattice.num_translations()) *
             180.0 / M_PI;
-        nearest = std::min(nearest, (offset_deg - v).cwiseQuotient(steps_deg).cwiseAbs().maxCoeff());
+        nearest =
+            std::min(nearest, (offset_deg - v).cwiseQuotient(steps_deg).cwiseAbs().maxCoeff());
       }
       EXPECT_LE(nearest, 0.5 + 1e-9) << v.transpose();
     }
     HypothesisLattice too_large;
-    EXPECT_FALSE(HypothesisLattice::Create(lattice_start, wide, LatticeSteps(), &too_large, 1000).ok());
+    EXPECT_FALSE(
+        HypothesisLattice::Create(lattice_start, wide, LatticeSteps(), &too_large, 1000).ok());
     const CalibrationFrame& frame = *window[0];
     ASSERT_FALSE(frame.coarse_map[0].empty());
     std::vector<float> scores;
@@ -565,10 +567,11 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
     const Eigen::Vector3d rotation_offset_deg =
         LogSO3(best.T_camera_lidar.linear() * truth.T_camera_lidar.linear().transpose()) * 180 /
         M_PI;
-    std::printf("lattice: best hypothesis off the truth by (%.2f, %.2f, %.2f) deg about camera x, "
-                "y, z, δ %+.1f ms\n",
-                rotation_offset_deg.x(), rotation_offset_deg.y(), rotation_offset_deg.z(),
-                1000 * (best.time_offset_s - truth.time_offset_s));
+    std::printf(
+        "lattice: best hypothesis off the truth by (%.2f, %.2f, %.2f) deg about camera x, "
+        "y, z, δ %+.1f ms\n",
+        rotation_offset_deg.x(), rotation_offset_deg.y(), rotation_offset_deg.z(),
+        1000 * (best.time_offset_s - truth.time_offset_s));
     for (int k = 0; k < 3; ++k) {
       EXPECT_LE(std::abs(rotation_offset_deg[k]), LatticeSteps().rotation_deg[k]) << k;
     }

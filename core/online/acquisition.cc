@@ -32,7 +32,8 @@ Dominance JudgeDominance(const std::vector<std::vector<double>>& frame_scores,
   const CalibrationState& best = states[out.best];
   const int n = out.frames;
   // Frames sharing a sweep through their local maps are one observation, not several.
-  const double effective_n = std::max(1.0, static_cast<double>(n) / std::max(1, shared_sweep_frames));
+  const double effective_n =
+      std::max(1.0, static_cast<double>(n) / std::max(1, shared_sweep_frames));
   // Each frame's gains relative to that frame's scale (the mean |score| of the hypotheses on it):
   // frames with many edges score higher and would otherwise weigh more in the spread.
   std::vector<double> scale(n, 0.0);
@@ -47,8 +48,8 @@ Dominance JudgeDominance(const std::vector<std::vector<double>>& frame_scores,
     rival.rotation_deg =
         RotationErrorDeg(states[k].T_camera_lidar.linear(), best.T_camera_lidar.linear());
     rival.time_offset_s = states[k].time_offset_s - best.time_offset_s;
-    rival.score_share = sums[out.best] != 0 ? (sums[out.best] - sums[k]) / std::abs(sums[out.best])
-                                            : 0.0;
+    rival.score_share =
+        sums[out.best] != 0 ? (sums[out.best] - sums[k]) / std::abs(sums[out.best]) : 0.0;
     rival.merged = rival.rotation_deg < options.merge_deg;
     double mean = 0, square = 0;
     for (int f = 0; f < n; ++f) mean += (frame_scores[out.best][f] - frame_scores[k][f]) / scale[f];
@@ -83,7 +84,8 @@ std::string DescribeRivals(const Dominance& dominance) {
     if (static_cast<int>(k) == dominance.best) continue;
     const RivalMargin& r = dominance.rivals[k];
     char line[160];
-    std::snprintf(line, sizeof(line), "%s%.2f deg and %+.1f ms from the best, %.1f %% lower, %.1f SE%s",
+    std::snprintf(line, sizeof(line),
+                  "%s%.2f deg and %+.1f ms from the best, %.1f %% lower, %.1f SE%s",
                   out.empty() ? "" : "; ", r.rotation_deg, 1000 * r.time_offset_s,
                   100 * r.score_share, r.t_statistic, r.merged ? " (same peak)" : "");
     out += line;
@@ -166,7 +168,10 @@ const std::vector<Hypothesis>& Acquisition::Update(WindowScorer* search, WindowS
     scores.push_back(h.frame_scores);
     states.push_back(h.state);
   }
-  dominance_ = JudgeDominance(scores, states, shared_sweep_frames);
+  // A refinement window shorter than DominanceOptions::min_frames is all there is to compare on.
+  DominanceOptions dominance;
+  dominance.min_frames = std::min(dominance.min_frames, max_frames_);
+  dominance_ = JudgeDominance(scores, states, shared_sweep_frames, dominance);
   // Best first (the dominance's best leads; the rivals keep their order and their margins).
   if (dominance_.best > 0) {
     std::swap(next[0], next[dominance_.best]);

@@ -13,16 +13,16 @@ namespace stcalib {
 // A hypothesis the acquisition carries from frame to frame (docs/method.md §7): a peak of the
 // lattice's window score, refined on the fine maps.
 struct Hypothesis {
-  bool incumbent = false;       ///< refined from the estimate itself, not from a lattice point
-  size_t lattice_index = 0;     ///< its lattice point (the best δ and translation of its rotation)
-  double lattice_score = 0;     ///< the window's coarse score there
-  CalibrationState state;       ///< refined on the fine maps (rotation and δ)
+  bool incumbent = false;    ///< refined from the estimate itself, not from a lattice point
+  size_t lattice_index = 0;  ///< its lattice point (the best δ and translation of its rotation)
+  double lattice_score = 0;  ///< the window's coarse score there
+  CalibrationState state;    ///< refined on the fine maps (rotation and δ)
   std::vector<double> frame_scores;  ///< fine score per frame of the refinement's window
 };
 
 // A runner-up measured against the best hypothesis over the same frames.
 struct RivalMargin {
-  double rotation_deg = 0;  ///< its rotation's distance from the best's [deg]
+  double rotation_deg = 0;   ///< its rotation's distance from the best's [deg]
   double time_offset_s = 0;  ///< its δ − the best's [s]
   // (best − rival) ÷ best, of the fine scores summed over the frames.
   double score_share = 0;
@@ -36,8 +36,8 @@ struct RivalMargin {
 // Whether one hypothesis dominates the others over the frames seen: the rule that ends the
 // acquisition (Judge's `one_hypothesis_dominates`, docs/method.md §7).
 struct Dominance {
-  int frames = 0;          ///< frames the hypotheses were compared over
-  int best = -1;           ///< index of the best hypothesis (highest fine score), -1: none
+  int frames = 0;                   ///< frames the hypotheses were compared over
+  int best = -1;                    ///< index of the best hypothesis (highest fine score), -1: none
   std::vector<RivalMargin> rivals;  ///< one per hypothesis (the best's own entry is empty)
   bool dominant = false;
   std::string detail;  ///< what was measured; the rivals still standing when not dominant
@@ -67,7 +67,7 @@ class Acquisition {
   // Fine-map points per frame the lattice reads (evenly thinned).
   static constexpr int kLatticePoints = 256;
 
-  explicit Acquisition(int window_frames) : window_(window_frames) {}
+  explicit Acquisition(int window_frames) : max_frames_(window_frames), window_(window_frames) {}
   // A new lattice around `centre` over `span`, which scores `frames` (oldest first) at once.
   Status Centre(const CalibrationState& centre, const std::vector<const CalibrationFrame*>& frames,
                 double horizontal_weight, const StartUncertainty& span);
@@ -92,6 +92,7 @@ class Acquisition {
   int frames() const { return window_.frames(); }
 
  private:
+  int max_frames_;  // the lattice's window, the refinement's frames
   HypothesisLattice lattice_;
   LatticeWindow window_;
   std::vector<float> scratch_;

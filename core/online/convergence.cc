@@ -419,9 +419,9 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
   if (only_these_fail({kJackknifeRule, kSuppressedCheckRule})) {
     std::vector<const CalibrationFrame*> frames;
     for (const auto& frame : recent) frames.push_back(frame.get());
-    evidence.rotation_jackknife = JackknifeRotation(frames, verdict.estimate, initial,
-                                                    calibrator.RefineOptionsInUse(),
-                                                    verdict.shared_sweep_frames);
+    evidence.rotation_jackknife =
+        JackknifeRotation(frames, verdict.estimate, initial, calibrator.RefineOptionsInUse(),
+                          verdict.shared_sweep_frames);
     verdict.rotation_jackknife = *evidence.rotation_jackknife;
     judgement = Judge(evidence, options);
   }

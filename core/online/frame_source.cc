@@ -147,7 +147,7 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   if (!out->image.empty()) {
     const bool oriented = options_.oriented_maps;
     for (int kind = 0; kind < 2; ++kind) {
-      const cv::Mat& raw = !oriented    ? out->image.distance_raw_px
+      const cv::Mat& raw = !oriented   ? out->image.distance_raw_px
                            : kind == 0 ? out->image.distance_vertical_raw_px
                                        : out->image.distance_horizontal_raw_px;
       out->coarse_map[kind] = CoarseScoreMap(raw, kCoarseBasinPx, kCoarseMapScale);

@@ -137,9 +137,12 @@ OnlineCalibratorOptions WithStartUncertainty(const OnlineCalibratorOptions& opti
       std::max(out.search.max_rotation_offset_deg, kAxes * u.rotation_deg + kBasinDeg);
   out.search.max_translation_offset_m =
       std::max(out.search.max_translation_offset_m, kAxes * u.translation_m + 0.05);
-  out.search.translation_prior_sigma_m = std::max(out.search.translation_prior_sigma_m, u.translation_m);
-  out.refine.prior_sigma_translation_m = std::max(out.refine.prior_sigma_translation_m, u.translation_m);
-  out.search.time_offset_prior_sigma_s = std::max(out.search.time_offset_prior_sigma_s, u.time_offset_s);
+  out.search.translation_prior_sigma_m =
+      std::max(out.search.translation_prior_sigma_m, u.translation_m);
+  out.refine.prior_sigma_translation_m =
+      std::max(out.refine.prior_sigma_translation_m, u.translation_m);
+  out.search.time_offset_prior_sigma_s =
+      std::max(out.search.time_offset_prior_sigma_s, u.time_offset_s);
   out.refine.prior_sigma_time_s = std::max(out.refine.prior_sigma_time_s, u.time_offset_s);
   out.time_offset_bound_s =
       std::max(out.time_offset_bound_s, std::abs(initial_time_offset_s) + u.time_offset_s);
@@ -148,9 +151,7 @@ OnlineCalibratorOptions WithStartUncertainty(const OnlineCalibratorOptions& opti
 
 OnlineCalibrator::OnlineCalibrator(const OnlineCalibratorOptions& options,
                                    const CalibrationState& initial)
-    : options_(WithSharedSettings(options)),
-      state_(initial),
-      acquisition_(options.refine_frames) {
+    : options_(WithSharedSettings(options)), state_(initial), acquisition_(options.refine_frames) {
   CHECK(options_.Validate().ok()) << options_.Validate().message();
   state_.time_offset_s =
       std::clamp(state_.time_offset_s, -options_.time_offset_bound_s, options_.time_offset_bound_s);
@@ -493,17 +494,16 @@ void OnlineCalibrator::MeasureEstimate(WindowScorer* scorer, WindowScorer* healt
 }
 
 void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
-                              const AdaptiveGridSearchOptions& search_options,
-                              bool read_hypotheses, FrameReport* report) {
+                              const AdaptiveGridSearchOptions& search_options, bool read_hypotheses,
+                              FrameReport* report) {
   const auto start = std::chrono::steady_clock::now();
   CalibrationState search_start = state_;
   int evaluations = 0;
   if (read_hypotheses) {
     // The lattice's best peaks, refined on the fine maps and compared frame by frame on the
     // refinement's frames; the search starts from the best.
-    const std::vector<Hypothesis>& hypotheses =
-        acquisition_.Update(scorer, long_scorer, state_, anchor_, search_options,
-                            SharedSweepFrames(), &evaluations);
+    const std::vector<Hypothesis>& hypotheses = acquisition_.Update(
+        scorer, long_scorer, state_, anchor_, search_options, SharedSweepFrames(), &evaluations);
     // On the estimate's own peak the search refines the estimate; elsewhere it starts afresh
     // from the best hypothesis: while acquiring, once that leads the estimate's own by
     // kJumpStandardErrors; once acquired (a lost estimate), it leaves the last healthy
@@ -611,9 +611,10 @@ void OnlineCalibrator::Choose(const std::vector<Candidate>& candidates, WindowSc
     const Eigen::Vector3d rotation =
         LogSO3(state_.T_camera_lidar.linear().transpose() * c.T_camera_lidar.linear());
     const double g_rotation =
-        report->from_hypotheses ? 1.0
-                              : TrackingRotationShare(g, rotation.norm(),
-                                                      options_.tracking_max_lag_deg * M_PI / 180.0);
+        report->from_hypotheses
+            ? 1.0
+            : TrackingRotationShare(g, rotation.norm(),
+                                    options_.tracking_max_lag_deg * M_PI / 180.0);
     report->after = Step(state_, g_rotation * rotation,
                          g * (c.T_camera_lidar.translation() - state_.T_camera_lidar.translation()),
                          g * (c.time_offset_s - state_.time_offset_s));

@@ -6,9 +6,9 @@
 #include <optional>
 #include <string>
 
+#include "core/online/acquisition.h"
 #include "core/refine/refine.h"
 #include "core/score/calibration_frame.h"
-#include "core/online/acquisition.h"
 #include "core/score/score.h"
 #include "core/search/adaptive_grid_search.h"
 #include "core/search/hypothesis_lattice.h"
@@ -49,7 +49,7 @@ struct OnlineCalibratorOptions {
   RefineOptions refine;
   // Horizontal LiDAR edges are the less faithful ones (foliage tops scatter), so they weigh less
   // than vertical ones. Measured: docs/tuning.md#horizontal-weight
-  double horizontal_weight = 0.2;  ///< w of docs/method.md §6, while the folds are read
+  double horizontal_weight = 0.2;     ///< w of docs/method.md §6, while the folds are read
   double time_offset_bound_s = 0.15;  ///< |δ| bound for search and refinement [s]
   // How far the start may be off on each axis: the acquisition's lattice spans it, and the search
   // bounds and priors hold it (WithStartUncertainty). docs/method.md §7
@@ -64,7 +64,8 @@ struct OnlineCalibratorOptions {
   // first-order filter over windows that scatter by a few tenths of a degree.
   double tracking_gain = 0.3;
   // ... but the rotation never lags an accepted update's estimate by more than this
-  // (TrackingRotationShare; 0 = tracking_gain alone) [deg]. Measured: docs/tuning.md#tracking-max-lag
+  // (TrackingRotationShare; 0 = tracking_gain alone) [deg]. Measured:
+  // docs/tuning.md#tracking-max-lag
   double tracking_max_lag_deg = 0.3;
   // The refined rotation (with the chosen candidate's translation and δ) is taken in place of the
   // best-scoring candidate when it scores within this share of the best: the score finds the

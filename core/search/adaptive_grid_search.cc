@@ -147,7 +147,6 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
   return result;
 }
 
-
 namespace {
 
 // Best and second local maximum (at least min_separation away) of a 1-D score profile.

@@ -17,8 +17,8 @@ namespace {
 // Offsets k·step, |k| ≤ K with K·step + step/2 ≥ span: every offset within the span lies within
 // half a step of one of them (only k = 0 when the span is under half a step).
 std::vector<int> AxisCells(double span, double step) {
-  const int half = step > 0 ? std::max(0, static_cast<int>(std::ceil(span / step - 0.5 - 1e-9)))
-                            : 0;
+  const int half =
+      step > 0 ? std::max(0, static_cast<int>(std::ceil(span / step - 0.5 - 1e-9))) : 0;
   std::vector<int> cells;
   for (int k = -half; k <= half; ++k) cells.push_back(k);
   return cells;
@@ -92,8 +92,8 @@ Status HypothesisLattice::Create(const CalibrationState& centre, const StartUnce
     for (int b : r[1]) {
       for (int c : r[2]) {
         out.rotation_cells_.emplace_back(a, b, c);
-        out.rotations_.push_back(
-            Eigen::Vector3d(a, b, c).cwiseProduct(steps.rotation_deg) * kDegToRad);
+        out.rotations_.push_back(Eigen::Vector3d(a, b, c).cwiseProduct(steps.rotation_deg) *
+                                 kDegToRad);
       }
     }
   }
@@ -227,8 +227,7 @@ void ScoreFrameOnLattice(const CalibrationFrame& frame, const HypothesisLattice&
                              map_v.rows, inv_scale, cell_offset, min_depth, out);
       AccumulateTranslations(y0.data(), y1.data(), y2.data(), weight.data(), num_vertical,
                              num_points, b.data(), static_cast<int>(num_t), map_h.ptr<float>(),
-                             map_h.cols, map_h.rows, inv_scale, cell_offset, min_depth,
-                             out);
+                             map_h.cols, map_h.rows, inv_scale, cell_offset, min_depth, out);
     }
   }
 }
@@ -279,7 +278,8 @@ std::vector<size_t> TopHypotheses(const HypothesisLattice& lattice, const std::v
     if (static_cast<int>(top.size()) >= count) break;
     bool separate = true;
     for (size_t h : top) {
-      const Eigen::Vector3i gap = lattice.RotationCell(r) - lattice.RotationCell(lattice.RotationOf(h));
+      const Eigen::Vector3i gap =
+          lattice.RotationCell(r) - lattice.RotationCell(lattice.RotationOf(h));
       if (gap.cwiseAbs().maxCoeff() < min_separation_cells) separate = false;
     }
     if (separate) top.push_back(best[r]);

@@ -36,9 +36,9 @@ std::string StartUncertaintyText(const StartUncertainty& uncertainty);
 // the view moves near points sideways, along the view and vertically barely.
 // Measured: docs/tuning.md#lattice-steps
 struct LatticeSteps {
-  Eigen::Vector3d rotation_deg{1.0, 0.75, 2.0};    ///< about camera x, y, z [deg]
-  Eigen::Vector3d translation_m{0.2, 0.4, 0.4};    ///< along camera x, y, z [m]
-  double time_offset_s = 0.04;                     ///< [s]
+  Eigen::Vector3d rotation_deg{1.0, 0.75, 2.0};  ///< about camera x, y, z [deg]
+  Eigen::Vector3d translation_m{0.2, 0.4, 0.4};  ///< along camera x, y, z [m]
+  double time_offset_s = 0.04;                   ///< [s]
 };
 
 // A fixed set of calibration hypotheses around a centre: every combination of rotation offsets
