@@ -407,10 +407,11 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       const Eigen::Vector3d t = h.state.T_camera_lidar.translation();
       nlohmann::json entry = {
           {"best", static_cast<int>(k) == dominance.best},
+          {"incumbent", h.incumbent},
           {"rpy_deg", {{"roll", h_rpy.x()}, {"pitch", h_rpy.y()}, {"yaw", h_rpy.z()}}},
           {"translation_m", {{"x", t.x()}, {"y", t.y()}, {"z", t.z()}}},
-          {"time_offset_s", h.state.time_offset_s},
-          {"lattice_score", h.lattice_score}};
+          {"time_offset_s", h.state.time_offset_s}};
+      if (!h.incumbent) entry["lattice_score"] = h.lattice_score;
       if (static_cast<int>(k) != dominance.best && k < dominance.rivals.size()) {
         const RivalMargin& r = dominance.rivals[k];
         entry["rotation_from_best_deg"] = r.rotation_deg;

@@ -182,9 +182,10 @@ cv::Mat CoarseScoreMap(const cv::Mat& distance_raw_px, double basin_px, int scal
   CHECK_GT(scale, 0);
   CHECK(basin_px > 0);
   cv::Mat distance, idt, blurred, padded;
-  cv::resize(distance_raw_px, distance,
-             cv::Size(distance_raw_px.cols / scale, distance_raw_px.rows / scale), 0, 0,
-             cv::INTER_AREA);
+  // Whole cells only, so that cell j covers pixels [j·scale, (j + 1)·scale) exactly.
+  const cv::Size cells(distance_raw_px.cols / scale, distance_raw_px.rows / scale);
+  cv::resize(distance_raw_px(cv::Rect(0, 0, cells.width * scale, cells.height * scale)), distance,
+             cells, 0, 0, cv::INTER_AREA);
   cv::min(distance, basin_px, distance);
   distance.convertTo(idt, CV_32F, -255.0 / basin_px, 255.0);
   const double sigma = basin_px / scale;

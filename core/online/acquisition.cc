@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "core/types/transform.h"
 
@@ -125,6 +126,9 @@ const std::vector<Hypothesis>& Acquisition::Update(WindowScorer* search, WindowS
   refine.first_level = search->num_levels() - 1;
   std::vector<Hypothesis> next;
   for (size_t k = 0; k <= top.size(); ++k) {
+    // A lattice point outside the search's bounds (the lattice reaches half a step past the
+    // span) could win and never be taken.
+    if (k < top.size() && !WithinBounds(lattice_.State(top[k]), anchor, options)) continue;
     Hypothesis hypothesis;
     if (k == top.size()) {  // the estimate, as one hypothesis among the others
       hypothesis.incumbent = true;
@@ -170,7 +174,7 @@ const std::vector<Hypothesis>& Acquisition::Update(WindowScorer* search, WindowS
   }
   // A refinement window shorter than DominanceOptions::min_frames is all there is to compare on.
   DominanceOptions dominance;
-  dominance.min_frames = std::min(dominance.min_frames, max_frames_);
+  dominance.min_frames = std::max(2, std::min(dominance.min_frames, max_frames_));
   dominance_ = JudgeDominance(scores, states, shared_sweep_frames, dominance);
   // Best first (the dominance's best leads; the rivals keep their order and their margins).
   if (dominance_.best > 0) {

@@ -104,7 +104,7 @@ RuleOutcome OneHypothesisDominates(const ConvergenceEvidence& e, const Convergen
   if (!e.acquiring) {
     return {name, true,
             "acquisition ended: one hypothesis dominated" +
-                (e.dominance.detail.empty() ? std::string() : " (" + e.dominance.detail + ")")};
+                (e.dominance.dominant ? " (" + e.dominance.detail + ")" : std::string())};
   }
   const std::string rivals = DescribeRivals(e.dominance);
   return {name, false,

@@ -67,6 +67,11 @@ Status OnlineCalibratorOptions::Validate() const {
         start_uncertainty.time_offset_s > 0)) {
     return Status::Error("online: every start_uncertainty figure must be > 0");
   }
+  if (HypothesisLattice::CountFor(start_uncertainty, LatticeSteps()) >
+      HypothesisLattice::kMaxHypotheses) {
+    return Status::Error("online: start_uncertainty " + StartUncertaintyText(start_uncertainty) +
+                         " makes a lattice too large for memory");
+  }
   STCALIB_RETURN_IF_ERROR(search.Validate());
   return refine.Validate();
 }
@@ -300,6 +305,9 @@ bool OnlineCalibrator::DropFoldsOnceAcquired() {
       !folds_dropped_) {
     folds_dropped_ = true;
     refit_pending_ = true;
+    // A lattice re-centred while lost holds frames with their folds: score them again as read
+    // from now on.
+    if (phase_ == Phase::kLost) RecentreLattice(acquisition_.lattice().centre(), LostSpan());
   }
   return refit_pending_;
 }
@@ -357,6 +365,21 @@ bool OnlineCalibrator::Update(WindowScorer* scorer, bool full_step, FrameReport*
   return read_hypotheses;
 }
 
+StartUncertainty OnlineCalibrator::LostSpan() const {
+  const StartUncertainty& start = options_.start_uncertainty;
+  return {std::min(start.rotation_deg, kLostSpan.rotation_deg),
+          std::min(start.translation_m, kLostSpan.translation_m),
+          std::min(start.time_offset_s, kLostSpan.time_offset_s)};
+}
+
+void OnlineCalibrator::RecentreLattice(const CalibrationState& centre,
+                                       const StartUncertainty& span) {
+  // The span is at most the start's, whose lattice Validate() admitted.
+  const Status centred = acquisition_.Centre(centre, LatestFrames(options_.refine_frames),
+                                             ScoreOptionsInUse().horizontal_weight, span);
+  CHECK(centred.ok()) << centred.message();
+}
+
 void OnlineCalibrator::UpdatePhase(int window_size, double health, bool dominant) {
   PhaseInputs in;
   in.window_size = window_size;
@@ -369,14 +392,7 @@ void OnlineCalibrator::UpdatePhase(int window_size, double health, bool dominant
   if (phase_ == Phase::kLost && before != Phase::kLost) {
     // Re-acquire around the last healthy estimate: the lattice, over a disturbance's span (a lost
     // estimate was good a moment ago), scores the window's frames anew.
-    const StartUncertainty& start = options_.start_uncertainty;
-    const StartUncertainty span{std::min(start.rotation_deg, kLostSpan.rotation_deg),
-                                std::min(start.translation_m, kLostSpan.translation_m),
-                                std::min(start.time_offset_s, kLostSpan.time_offset_s)};
-    const Status centred = acquisition_.Centre(has_last_healthy_ ? last_healthy_ : state_,
-                                               LatestFrames(options_.refine_frames),
-                                               ScoreOptionsInUse().horizontal_weight, span);
-    CHECK(centred.ok()) << centred.message();
+    RecentreLattice(has_last_healthy_ ? last_healthy_ : state_, LostSpan());
   }
 }
 

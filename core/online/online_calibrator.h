@@ -41,47 +41,47 @@ struct OnlineCalibratorOptions {
   int window_frames = 3;  ///< sliding window of frames searched together
   // The refinement, the candidates' judge and the acquisition's dominance read this many latest
   // frames. Measured: docs/tuning.md#refine-frames
-  int refine_frames = 20;
+  int refine_frames = 20;  ///< frames of the refinement and the hypotheses' judge [frames]
   // score.horizontal_weight, refine.horizontal_weight and both time_offset_bound_s are set from
   // the fields below (one setting, one home) by WithSharedSettings, which the calibrator applies.
-  ScoreOptions score;
-  AdaptiveGridSearchOptions search;
-  RefineOptions refine;
+  ScoreOptions score;                ///< the score (its horizontal_weight shared)
+  AdaptiveGridSearchOptions search;  ///< the local search (its δ bound shared)
+  RefineOptions refine;              ///< the refinement (its weight and δ bound shared)
   // Horizontal LiDAR edges are the less faithful ones (foliage tops scatter), so they weigh less
   // than vertical ones. Measured: docs/tuning.md#horizontal-weight
   double horizontal_weight = 0.2;     ///< w of docs/method.md §6, while the folds are read
   double time_offset_bound_s = 0.15;  ///< |δ| bound for search and refinement [s]
   // How far the start may be off on each axis: the acquisition's lattice spans it, and the search
-  // bounds and priors hold it (WithStartUncertainty). docs/method.md §7
-  StartUncertainty start_uncertainty;
+  // bounds and priors hold it (WithStartUncertainty). docs/method.md §6
+  StartUncertainty start_uncertainty;  ///< [deg, m, s] per axis
   // Health (docs/method.md §7) under this at an acquired estimate means lost: it re-acquires.
-  double lost_health = 0.9;
+  double lost_health = 0.9;  ///< health under which an acquired estimate is lost [0..1]
   // Points are kept when they project inside the image shrunk by this share of its size on each
   // side (negative: grown), at the estimate when their frame arrives. A band-pass score is near
   // zero on average, so points just outside the image cost nothing: keep them.
-  double point_margin = -0.1;
+  double point_margin = -0.1;  ///< share of the image size on each side [ratio]
   // While tracking, an accepted update moves this share of the way to the new estimate: a
   // first-order filter over windows that scatter by a few tenths of a degree.
-  double tracking_gain = 0.3;
+  double tracking_gain = 0.3;  ///< share of the way a tracking update moves [0..1]
   // ... but the rotation never lags an accepted update's estimate by more than this
   // (TrackingRotationShare; 0 = tracking_gain alone) [deg]. Measured:
   // docs/tuning.md#tracking-max-lag
-  double tracking_max_lag_deg = 0.3;
+  double tracking_max_lag_deg = 0.3;  ///< [deg]
   // The refined rotation (with the chosen candidate's translation and δ) is taken in place of the
   // best-scoring candidate when it scores within this share of the best: the score finds the
   // peak, the refinement where on it. 0 = the best score wins.
   // Measured: docs/tuning.md#refined-score-tolerance
-  double refined_score_tolerance = 0.1;
+  double refined_score_tolerance = 0.1;  ///< share of the best score [0..1)
   // While tracking (healthy), the search and refinement run on every n-th frame only; the frames
   // between join the window and have their health measured. 1 = update on every frame.
-  int tracking_update_every = 3;
+  int tracking_update_every = 3;  ///< frames per update while tracking [frames]
   // The LiDAR edges' folds (LidarEdgeOptions::fold_height_tolerance_m): kept, dropped from every
   // window, or dropped once acquired (the default: the acquisition reads them; tracking,
   // refinement, polish and the verdict's profiles do not, at kFoldFreeHorizontalWeight). The
   // health reads every point whatever the choice (HealthWindow). The first frame without them
   // updates at once and by a full step. Measured: docs/tuning.md#folds
   enum class Folds { kKeep, kDrop, kDropWhenTracking };
-  Folds folds = Folds::kDropWhenTracking;
+  Folds folds = Folds::kDropWhenTracking;  ///< which windows read the folds
 
   Status Validate() const;
 };
@@ -302,6 +302,10 @@ class OnlineCalibrator {
   // The estimate becomes the last healthy one when `health` reaches lost_health on a full window.
   void RememberIfHealthy(double health, size_t window_size);
 
+  // A lost estimate's lattice span: the start's, at most kLostSpan (online_calibrator.cc).
+  StartUncertainty LostSpan() const;
+  // A new lattice around `centre` over `span`, scoring the refinement's frames as read now.
+  void RecentreLattice(const CalibrationState& centre, const StartUncertainty& span);
   // phase_ after this frame's window size, health and whether a hypothesis dominates; on
   // becoming lost, the lattice is centred on the last healthy estimate.
   void UpdatePhase(int window_size, double health, bool dominant = false);

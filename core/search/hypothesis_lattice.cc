@@ -128,10 +128,19 @@ namespace {
 // nearest cell, padding included), weighted. Points from `begin` to `end`
 // read `map` (one edge kind). Written for the compiler to vectorise over points (gathers under
 // AVX2 and AVX-512, which the clones select at run time).
-__attribute__((target_clones("avx512f", "avx2", "default"))) void AccumulateTranslations(
-    const float* y0, const float* y1, const float* y2, const float* weight, int begin, int end,
-    const float* b, int num_translations, const float* map, int map_cols, int map_rows,
-    float inv_scale, float cell_offset, float min_depth, float* out) {
+// Under AddressSanitizer the clones' run-time resolver would run before the sanitizer's start-up:
+// one portable version there.
+#if defined(__SANITIZE_ADDRESS__)
+#define STCALIB_VECTOR_CLONES
+#else
+#define STCALIB_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+STCALIB_VECTOR_CLONES void AccumulateTranslations(const float* y0, const float* y1, const float* y2,
+                                                  const float* weight, int begin, int end,
+                                                  const float* b, int num_translations,
+                                                  const float* map, int map_cols, int map_rows,
+                                                  float inv_scale, float cell_offset,
+                                                  float min_depth, float* out) {
   const float max_x = static_cast<float>(map_cols - 1);
   const float max_y = static_cast<float>(map_rows - 1);
   for (int c = 0; c < num_translations; ++c) {
@@ -159,7 +168,10 @@ void ScoreFrameOnLattice(const CalibrationFrame& frame, const HypothesisLattice&
                          double horizontal_weight, int max_points, std::vector<float>* scores) {
   scores->assign(lattice.size(), 0.0f);
   const int scale = frame.coarse_map_scale;
-  if (frame.coarse_map[0].empty() || frame.coarse_map[1].empty() || scale <= 0) return;
+  if (frame.coarse_map[0].empty() || frame.coarse_map[1].empty() || scale <= 0 ||
+      frame.kinds.size() != frame.size()) {
+    return;
+  }
   // Evenly thinned points, vertical ones first (each kind reads its own map).
   const size_t n = frame.size();
   const size_t keep = max_points > 0 ? std::min<size_t>(n, max_points) : n;
