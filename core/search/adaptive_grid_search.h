@@ -15,8 +15,9 @@ namespace stcalib {
 // one (α1 rotation, α2 translation) while the gray rate is below γ and the small one (α3, α4)
 // above it. When a neighbour is better the search keeps moving in that direction while the score
 // improves (steepest-direction following), then looks around again; a 1-D search over the time
-// offset is interleaved. It runs coarse-to-fine over the score maps of the frames (wide,
-// texture-suppressed basins first), which is what brings it back from several degrees.
+// offset is interleaved. It runs coarse-to-fine over the score maps the frames carry (the
+// calibrator's carry the finest only: its hypothesis lattice, not the search, covers a start
+// several degrees off; docs/method.md §6).
 struct AdaptiveGridSearchOptions {
   double alpha1_rotation_deg = 1.0;    ///< large step pair: rotation [deg]
   double alpha2_translation_m = 0.04;  ///< large step pair: translation [m]
