@@ -128,20 +128,22 @@ const std::vector<Hypothesis>& Acquisition::Update(WindowScorer* search, WindowS
   for (size_t k = 0; k <= top.size(); ++k) {
     // A lattice point outside the search's bounds (the lattice reaches half a step past the
     // span) could win and never be taken.
-    if (k < top.size() && !WithinBounds(lattice_.State(top[k]), anchor, options)) continue;
     Hypothesis hypothesis;
     if (k == top.size()) {  // the estimate, as one hypothesis among the others
       hypothesis.incumbent = true;
       hypothesis.state = incumbent;
     } else {
       const size_t h = top[k];
+      hypothesis.state = lattice_.State(h);
+      if (!WithinBounds(hypothesis.state, anchor, options)) continue;
       hypothesis.lattice_index = h;
       hypothesis.lattice_score = window_.sums()[h];
-      hypothesis.state = lattice_.State(h);
+      // The peaks' rotations are distinct: at most one carried hypothesis matches.
       for (const Hypothesis& carried : hypotheses_) {
         if (!carried.incumbent &&
             lattice_.RotationOf(carried.lattice_index) == lattice_.RotationOf(h)) {
           hypothesis.state = carried.state;
+          break;
         }
       }
     }

@@ -47,17 +47,6 @@ TranslationMove TranslationMoveBeyondPrior(const CalibrationState& initial,
 
 namespace {
 
-// Frames that share sweeps through their local maps: 1 + the oldest sweep any point of `frames`
-// comes from (CalibrationFrame::sweep_ages; 1 without ages). The jackknife leaves out blocks of
-// this many frames, so that a block's sweeps are not all still in the frames it keeps.
-int SharedSweepFrames(const std::vector<const CalibrationFrame*>& frames) {
-  int oldest = 0;
-  for (const CalibrationFrame* frame : frames) {
-    for (uint8_t age : frame->sweep_ages) oldest = std::max<int>(oldest, age);
-  }
-  return oldest + 1;
-}
-
 std::string Format(const char* format, double a, double b = 0, double c = 0, double d = 0) {
   char text[512];
   std::snprintf(text, sizeof(text), format, a, b, c, d);

@@ -227,14 +227,6 @@ std::vector<const CalibrationFrame*> OnlineCalibrator::RefineWindow() const {
   return LatestFrames(options_.refine_frames);
 }
 
-int OnlineCalibrator::SharedSweepFrames() const {
-  int oldest = 0;
-  for (const WindowFrame& frame : window_) {
-    for (uint8_t age : frame.all->sweep_ages) oldest = std::max<int>(oldest, age);
-  }
-  return 1 + oldest;
-}
-
 std::string OnlineCalibrator::RefusalReason(const CalibrationFrame& frame) const {
   const bool finite_motion = std::isfinite(frame.e0_s) && std::isfinite(frame.camera_time_s) &&
                              frame.twist.linear_m_s.allFinite() &&
@@ -351,12 +343,13 @@ bool OnlineCalibrator::Update(WindowScorer* scorer, bool full_step, FrameReport*
   const bool read_hypotheses = phase_ == Phase::kAcquiring || phase_ == Phase::kLost ||
                                report->health_before < options_.lost_health;
   // The refinement's frames, every point of their maps: the hypotheses' and candidates' judge.
-  WindowScorer long_scorer(LatestFrames(options_.refine_frames), ScoreOptionsInUse());
+  const std::vector<const CalibrationFrame*> refine_window = RefineWindow();
+  WindowScorer long_scorer(refine_window, ScoreOptionsInUse());
   AdaptiveGridSearchOptions search_options = options_.search;
   search_options.first_level = scorer->num_levels() - 1;
   Search(scorer, &long_scorer, search_options, read_hypotheses, report);
   const auto start = std::chrono::steady_clock::now();
-  report->refine = Refine(RefineWindow(), report->search.state, report->search.state, anchor_,
+  report->refine = Refine(refine_window, report->search.state, report->search.state, anchor_,
                           RefineOptionsInUse());
   report->refine_ms = MillisecondsSince(start);
   Choose(Candidates(report), &long_scorer, search_options, full_step, report);
@@ -375,8 +368,8 @@ StartUncertainty OnlineCalibrator::LostSpan() const {
 void OnlineCalibrator::RecentreLattice(const CalibrationState& centre,
                                        const StartUncertainty& span) {
   // The span is at most the start's, whose lattice Validate() admitted.
-  const Status centred = acquisition_.Centre(centre, LatestFrames(options_.refine_frames),
-                                             ScoreOptionsInUse().horizontal_weight, span);
+  const Status centred =
+      acquisition_.Centre(centre, RefineWindow(), ScoreOptionsInUse().horizontal_weight, span);
   CHECK(centred.ok()) << centred.message();
 }
 
@@ -451,7 +444,7 @@ FrameReport OnlineCalibrator::Polish() {
   {
     CalibrationState online_rotation = polished;
     online_rotation.T_camera_lidar.linear() = state_.T_camera_lidar.linear();
-    WindowScorer window_scorer(LatestFrames(options_.refine_frames), ScoreOptionsInUse());
+    WindowScorer window_scorer(frames, ScoreOptionsInUse());
     if (window_scorer.Evaluate(polished, -1).score <
         window_scorer.Evaluate(online_rotation, -1).score) {
       polished = online_rotation;
@@ -519,7 +512,9 @@ void OnlineCalibrator::Search(WindowScorer* scorer, WindowScorer* long_scorer,
     // The lattice's best peaks, refined on the fine maps and compared frame by frame on the
     // refinement's frames; the search starts from the best.
     const std::vector<Hypothesis>& hypotheses = acquisition_.Update(
-        scorer, long_scorer, state_, anchor_, search_options, SharedSweepFrames(), &evaluations);
+        scorer, long_scorer, state_, anchor_, search_options,
+        SharedSweepFrames(LatestFrames(static_cast<int>(window_.size()), /*with_folds=*/true)),
+        &evaluations);
     // On the estimate's own peak the search refines the estimate; elsewhere it starts afresh
     // from the best hypothesis: while acquiring, once that leads the estimate's own by
     // kJumpStandardErrors; once acquired (a lost estimate), it leaves the last healthy

@@ -285,8 +285,6 @@ class OnlineCalibrator {
   void Choose(const std::vector<Candidate>& candidates, WindowScorer* long_scorer,
               const AdaptiveGridSearchOptions& search_options, bool full_step,
               FrameReport* report) const;
-  // Frames each sweep's points appear in through the local maps (1 + the oldest sweep age).
-  int SharedSweepFrames() const;
 
   // Score, gray rate and health at the estimate (health_before reused when it did not move).
   // `scorer` when `window` (the search window as read now) is HealthWindow() (Folds::kKeep, or

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -97,6 +98,18 @@ inline cv::Mat PlainIdt(const FrameImageAndMotion& frame, int kind) {
   cv::Mat idt;
   frame.distance_px[kind].convertTo(idt, CV_32F, -255.0 / frame.gray_basin_px, 255.0);
   return idt;
+}
+
+// Frames that share sweeps through their local maps: 1 + the oldest sweep any point of `frames`
+// comes from (CalibrationFrame::sweep_ages; 1 without ages). The jackknife leaves out blocks of
+// this many frames, so that a block's sweeps are not all still in the frames it keeps; the
+// acquisition's dominance counts them once.
+inline int SharedSweepFrames(const std::vector<const CalibrationFrame*>& frames) {
+  int oldest = 0;
+  for (const CalibrationFrame* frame : frames) {
+    for (uint8_t age : frame->sweep_ages) oldest = std::max<int>(oldest, age);
+  }
+  return oldest + 1;
 }
 
 // Pixel of edge point i of `frame` at `state` (carried by the motion model over e0 + δ, then

@@ -202,13 +202,13 @@ void ScoreFrameOnLattice(const CalibrationFrame& frame, const HypothesisLattice&
   const size_t num_d = lattice.num_time_offsets();
   const size_t num_r = lattice.num_rotations();
   // The points carried by the motion model over e0 + δ, one set per δ of the lattice.
-  std::vector<Eigen::Vector3d> moved(num_d * num_points);
+  std::vector<Eigen::Vector3f> moved(num_d * num_points);  // in float once, read per rotation
   for (size_t d = 0; d < num_d; ++d) {
     const double e = frame.e0_s + centre.time_offset_s + lattice.TimeOffsetOffsetS(d * num_t);
     const Rigid3d Tv = LidarMotion(frame.twist, e);
     for (int k = 0; k < num_points; ++k) {
       const size_t i = k < num_vertical ? order[0][k] : order[1][k - num_vertical];
-      moved[d * num_points + k] = Tv * frame.points_lidar[i];
+      moved[d * num_points + k] = (Tv * frame.points_lidar[i]).cast<float>();
     }
   }
   const cv::Mat& map_v = frame.coarse_map[0];
@@ -226,9 +226,9 @@ void ScoreFrameOnLattice(const CalibrationFrame& frame, const HypothesisLattice&
     const Eigen::Matrix3f A =
         (M * ExpSO3(lattice.RotationOffsetRad(h_r)) * centre.T_camera_lidar.linear()).cast<float>();
     for (size_t d = 0; d < num_d; ++d) {
-      const Eigen::Vector3d* X = &moved[d * num_points];
+      const Eigen::Vector3f* X = &moved[d * num_points];
       for (int k = 0; k < num_points; ++k) {
-        const Eigen::Vector3f x = X[k].cast<float>();
+        const Eigen::Vector3f& x = X[k];
         y0[k] = A.row(0).dot(x);
         y1[k] = A.row(1).dot(x);
         y2[k] = A.row(2).dot(x);
