@@ -72,10 +72,11 @@ Status StartingCalibration(const Drive& drive, const std::string& init_calib,
   *T_camera_lidar = drive.T_camera_lidar;
   if (!init_calib.empty()) STCALIB_RETURN_IF_ERROR(ReadVeloToCam(init_calib, T_camera_lidar));
   auto sign = [&]() { return ((*rng)() & 1) ? 1.0 : -1.0; };
-  const Eigen::Vector3d rpy(sign() * perturb_rot_deg, sign() * perturb_rot_deg,
-                            sign() * perturb_rot_deg);
-  const Eigen::Vector3d dt(sign() * perturb_trans_m, sign() * perturb_trans_m,
-                           sign() * perturb_trans_m);
+  // One draw per statement, last axis first: the order every seed's start was drawn in so far
+  // (the arguments of one call are evaluated in an order C++ leaves open).
+  Eigen::Vector3d rpy, dt;
+  for (int axis = 2; axis >= 0; --axis) rpy[axis] = sign() * perturb_rot_deg;
+  for (int axis = 2; axis >= 0; --axis) dt[axis] = sign() * perturb_trans_m;
   *T_camera_lidar = PerturbTcameraLidar(*T_camera_lidar, rpy, dt);
   return Status::Ok();
 }

@@ -2,6 +2,8 @@
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -13,6 +15,20 @@
 
 namespace stcalib::cli {
 namespace {
+
+// A flag's default as a person writes it: "none" when empty, a double in its shortest form that
+// reads back to the same value (0.15, not gflags' 0.14999999999999999).
+std::string DefaultAsWritten(const gflags::CommandLineFlagInfo& info) {
+  if (info.default_value.empty()) return "none";
+  if (info.type != "double") return info.default_value;
+  const double value = std::strtod(info.default_value.c_str(), nullptr);
+  char text[32];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(text, sizeof(text), "%.*g", digits, value);
+    if (std::strtod(text, nullptr) == value) break;
+  }
+  return text;
+}
 
 struct Subcommand {
   const char* name;
@@ -156,8 +172,7 @@ int Main(int argc, char** argv) {
       for (const char* option : command->options) {
         gflags::CommandLineFlagInfo info;
         CHECK(gflags::GetCommandLineFlagInfo(option, &info)) << option;
-        std::cout << "  --" << info.name
-                  << " (default: " << (info.default_value.empty() ? "none" : info.default_value)
+        std::cout << "  --" << info.name << " (default: " << DefaultAsWritten(info)
                   << ")\n      " << info.description << "\n";
       }
       std::cout << "\nEvery other flag, with its default: stcalib " << command->name

@@ -69,6 +69,9 @@ TEST(Cli, SubcommandHelpListsAtMostTwentyOptions) {
       if (line.rfind("  --", 0) == 0) {
         ++options;
         EXPECT_THAT(line, HasSubstr("(default: ")) << command;
+        // Defaults as a person writes them: 0.15, not the binary 0.14999999999999999.
+        EXPECT_THAT(line, Not(::testing::ContainsRegex("[0-9]\\.[0-9]*(0000000|9999999)")))
+            << command;
       }
     }
     EXPECT_GE(options, 2) << command << "\n" << r.output;
@@ -78,6 +81,7 @@ TEST(Cli, SubcommandHelpListsAtMostTwentyOptions) {
   const RunResult calibrate = RunStcalib("calibrate --help");
   EXPECT_THAT(calibrate.output, HasSubstr("  --drive "));
   EXPECT_THAT(calibrate.output, HasSubstr("  --perturb_time_s "));
+  EXPECT_THAT(calibrate.output, HasSubstr("  --time_offset_bound_s (default: 0.15)"));
   EXPECT_THAT(calibrate.output, Not(HasSubstr("--tracking_gain")));
   EXPECT_THAT(RunStcalib("calibrate --helpfull").output, HasSubstr("tracking_gain"));
 }

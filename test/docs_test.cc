@@ -106,12 +106,14 @@ TEST(Docs, ReadmeQuickStartRunsAsWritten) {
   ASSERT_FALSE(commands.empty()) << "README.md has no ```sh block";
   const testing::ScopedTempDir tmp;
   for (std::string command : commands) {
-    const std::string binary = "build/apps/stcalib";
-    if (command.rfind(binary, 0) == 0) command = STCALIB_BINARY + command.substr(binary.size());
+    // The README's /tmp/ becomes the test's folder, then its binary this build's: in that order,
+    // so that a clone inside the temporary folder keeps the binary's own path.
     for (size_t at = command.find("/tmp/"); at != std::string::npos;
          at = command.find("/tmp/", at + tmp.path().size() + 1)) {
       command.replace(at, 5, tmp.path() + "/");
     }
+    const std::string binary = "build/apps/stcalib";
+    if (command.rfind(binary, 0) == 0) command = STCALIB_BINARY + command.substr(binary.size());
     std::string output;
     const int code = RunShell("cd " + kSource + " && " + command, &output);
     EXPECT_EQ(code, 0) << command << "\n" << output;
