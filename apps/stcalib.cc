@@ -172,8 +172,8 @@ int Main(int argc, char** argv) {
       for (const char* option : command->options) {
         gflags::CommandLineFlagInfo info;
         CHECK(gflags::GetCommandLineFlagInfo(option, &info)) << option;
-        std::cout << "  --" << info.name << " (default: " << DefaultAsWritten(info)
-                  << ")\n      " << info.description << "\n";
+        std::cout << "  --" << info.name << " (default: " << DefaultAsWritten(info) << ")\n      "
+                  << info.description << "\n";
       }
       std::cout << "\nEvery other flag, with its default: stcalib " << command->name
                 << " --helpfull\n";
