@@ -29,7 +29,8 @@ struct CalibrateJob {
 };
 
 struct CalibrateOutcome {
-  bool converged = false;
+  bool converged = false;              ///< a claim, whole or partial
+  std::vector<std::string> held_axes;  ///< held at their start values: a partial claim when any
   bool alias_suspect = false;
   std::string reason;
   bool has_truth = false;
@@ -58,7 +59,8 @@ std::string TimeOffsetRestsOn(const CalibrateOutcome& outcome);
 // One line (with its newline) saying that δ rests on the forward translation's prior, with the
 // pair's std and correlation when measured; empty when δ was separated or not estimated.
 std::string TimeOffsetPriorNote(const CalibrateOutcome& outcome);
-// Runs the job and writes its outputs; returns the exit code (0 only when converged).
+// Runs the job and writes its outputs; returns the exit code (0 when converged, kExitPartial when
+// converged partly).
 int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome);
 
 }  // namespace stcalib::cli

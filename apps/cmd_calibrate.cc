@@ -143,14 +143,29 @@ CalibrateJob CalibrateJobFromFlags() {
   return job;
 }
 
+bool TimeOffsetHeld(const CalibrateOutcome& outcome) {
+  return std::count(outcome.held_axes.begin(), outcome.held_axes.end(),
+                    std::string(kAxisNames[kNumAxes - 1])) > 0;
+}
+
 std::string TimeOffsetRestsOn(const CalibrateOutcome& outcome) {
-  if (!outcome.time_offset_estimated) return "start";
+  if (!outcome.time_offset_estimated || TimeOffsetHeld(outcome)) return "start";
   return outcome.time_forward.separated ? "window" : "forward_translation_prior";
 }
 
 std::string TimeOffsetPriorNote(const CalibrateOutcome& outcome) {
-  if (TimeOffsetRestsOn(outcome) != "forward_translation_prior") return "";
   const TimeForwardPair& pair = outcome.time_forward;
+  if (TimeOffsetHeld(outcome) && pair.measured) {
+    char numbers[160];
+    std::snprintf(numbers, sizeof(numbers),
+                  " (with the forward translation free: std %.1f ms and %.1f cm, correlation "
+                  "%+.2f)",
+                  1000 * pair.time_offset_std_s, 100 * pair.forward_std_m, pair.correlation);
+    return "time offset: held at its start, with the translation along travel: this drive does "
+           "not separate the two" +
+           std::string(numbers) + "\n";
+  }
+  if (TimeOffsetRestsOn(outcome) != "forward_translation_prior") return "";
   const std::string consequence =
       "so it rests on that translation's prior, as does the translation along travel (time "
       "offset error = forward error / speed)";
@@ -299,6 +314,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   outcome->estimate = verdict.estimate;
   outcome->error = ComputeCalibrationError(outcome->estimate, outcome->reference_state);
   outcome->converged = verdict.converged;
+  outcome->held_axes = verdict.held_axes;
   outcome->reason = verdict.reason;
   outcome->alias_suspect = verdict.time_offset_profile.alias_suspect;
   outcome->time_offset_estimated = job.online.refine.estimate_time_offset;
@@ -307,7 +323,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       verdict, outcome->time_offset_estimated, job.online.refine.observable_translation_m);
   outcome->observable = reported.observable;
   auto verdict_code = [&]() {
-    if (outcome->converged) return kExitOk;
+    if (outcome->converged) return outcome->held_axes.empty() ? kExitOk : kExitPartial;
     std::fprintf(stderr, "stcalib calibrate: %s\n", outcome->reason.c_str());
     return kExitFailure;
   };
@@ -350,9 +366,20 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const std::string out = job.out_dir;
   auto fail = [&](const Status& s) { return ReportError(kCommand, s); };
   if (outcome->converged) {
-    status = WriteVeloToCam(out + "/calib_velo_to_cam.txt", outcome->estimate.T_camera_lidar);
+    // A partial claim marks what it held in both files (the values there are the start's).
+    std::string held, time_held;
+    for (const std::string& axis : outcome->held_axes) {
+      if (axis == kAxisNames[kNumAxes - 1]) {
+        time_held = "held at the start: not observable in this drive";
+      } else {
+        held += (held.empty() ? "" : ", ") + axis;
+      }
+    }
+    if (!held.empty()) held = "held at the start (not observable in this drive): " + held;
+    status = WriteVeloToCam(out + "/calib_velo_to_cam.txt", outcome->estimate.T_camera_lidar, held);
     if (!status.ok()) return fail(status);
-    status = WriteTimeOffset(out + "/" + kTimeOffsetFileName, outcome->estimate.time_offset_s);
+    status = WriteTimeOffset(out + "/" + kTimeOffsetFileName, outcome->estimate.time_offset_s,
+                             time_held);
     if (!status.ok()) return fail(status);
   } else {
     // Never leave a file that claims success.
@@ -438,6 +465,10 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"rotation_profiles", profiles_json},
       {"suppressed_health_check", health_check_json},
       {"converged", outcome->converged},
+      {"claim", !outcome->converged          ? "none"
+                : outcome->held_axes.empty() ? "whole"
+                                             : "partial"},
+      {"held_axes", outcome->held_axes},
       {"reason", outcome->reason},
       {"phase", PhaseName(calibrator.phase())},
       {"hypotheses", hypotheses_json},
@@ -613,7 +644,10 @@ int RunCalibrate() {
   const int code = RunCalibrateJob(CalibrateJobFromFlags(), &outcome);
   if (outcome.reports.empty()) return code;
   const CalibrationError& e = outcome.error;
-  std::printf("%s after %zu frames (%s)\n", outcome.converged ? "converged" : "NOT converged",
+  std::printf("%s after %zu frames (%s)\n",
+              !outcome.converged          ? "NOT converged"
+              : outcome.held_axes.empty() ? "converged"
+                                          : "PARTLY converged",
               outcome.reports.size(), outcome.reason.c_str());
   std::printf(
       "%s: rotation %.3f deg (roll %+.3f, pitch %+.3f, yaw %+.3f), translation %.3f m, "

@@ -95,7 +95,8 @@ int RunDemo() {
               1000 * outcome.error.time_offset_s);
   std::printf("%s", TimeOffsetPriorNote(outcome).c_str());
   // A verdict other than success gives its reason ("not converged: ...").
-  const std::string verdict = outcome.converged ? "converged" : outcome.reason;
+  const std::string verdict =
+      outcome.converged && outcome.held_axes.empty() ? "converged" : outcome.reason;
   std::printf("\n%s; %.0f ms per frame; %.1f s in all\n", verdict.c_str(), outcome.mean_frame_ms,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   std::printf("pictures:\n");

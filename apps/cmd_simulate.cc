@@ -35,6 +35,7 @@ int RunSimulate() {
                       "--lidar must be " + sim::SimLidarChoices() + ", got '" + FLAGS_lidar + "'");
   }
   options.distortion_k1 = FLAGS_distortion_k1;
+  options.speed_mps = FLAGS_speed_mps;
   const Status valid = options.Validate();
   if (!valid.ok()) return UsageError("simulate", valid.message());
 

@@ -15,6 +15,9 @@ namespace stcalib::cli {
 constexpr int kExitOk = 0;
 constexpr int kExitFailure = 1;  ///< bad input, unreadable data, or a negative result
 constexpr int kExitUsage = 2;    ///< unknown subcommand, missing or invalid flag
+// calibrate: a partial claim. The rotation (and the axes observed) is claimed and written; the
+// axes the drive does not constrain keep their start values, marked held.
+constexpr int kExitPartial = 3;
 
 int RunInfo();
 int RunProject();

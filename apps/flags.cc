@@ -42,6 +42,10 @@ DEFINE_string(lidar, "hdl64",
 DEFINE_double(distortion_k1, 0.0,
               "simulate: radial distortion k1 of raw camera images (plumb_bob; 0 = rectified "
               "images, as KITTI's)");
+DEFINE_double(
+    speed_mps, 0.0,
+    "simulate: mean speed of the ego vehicle [m/s] (0 = a random 10-13 m/s; 1.5 = walking "
+    "pace, too slow for the time offset to be seen)");
 DEFINE_double(lidar_hz, 10.0, "simulate: LiDAR spin rate = frame rate of every sensor [Hz]");
 DEFINE_double(oxts_white_position_m, 0.001,
               "simulate: σ of each oxts packet's own position noise per axis, on top of the "

@@ -22,6 +22,7 @@ DECLARE_string(scene);
 DECLARE_string(camera);
 DECLARE_string(lidar);
 DECLARE_double(distortion_k1);
+DECLARE_double(speed_mps);
 DECLARE_double(lidar_hz);
 DECLARE_double(oxts_white_position_m);
 DECLARE_double(oxts_error_scale);

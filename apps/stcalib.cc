@@ -57,11 +57,11 @@ const std::vector<Subcommand>& Subcommands() {
        "--out=DIR [--frames=N (40)] [--seed=S (1)] [--time_offset_s=X (0)] "
        "[--dynamic_objects=K (6)] [--scene=urban|poles|open] [--lidar_hz=10] "
        "[--camera=kitti|kitti_1003|hd720] [--lidar=hdl64|vlp16|os1-64] [--distortion_k1=K] "
-       "[--oxts_white_position_m=0.001] [--oxts_error_scale=1]",
+       "[--speed_mps=V] [--oxts_white_position_m=0.001] [--oxts_error_scale=1]",
        "a KITTI-raw drive with exact ground truth (extrinsic, time offset, motion, labels)",
        &RunSimulate,
        {"out", "frames", "seed", "time_offset_s", "dynamic_objects", "scene", "camera", "lidar",
-        "distortion_k1", "lidar_hz", "oxts_white_position_m", "oxts_error_scale"}},
+        "distortion_k1", "speed_mps", "lidar_hz", "oxts_white_position_m", "oxts_error_scale"}},
       {"features",
        "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T) "
        "--frame=I --out=DIR",

@@ -871,6 +871,39 @@ TEST(Cli, SimulatedDriveMeetsTheAcceptance) {
             0.5);
 }
 
+// A drive at walking pace (1.5 m/s): over the true δ of +30 ms the LiDAR moves 4.5 cm, which the
+// score cannot see. The run claims what it observed (docs/method.md §7, partial claims): the
+// rotation, with δ and the translation along travel held at the start and marked so in every
+// output, exit 3. `check` reads the marked files back.
+TEST(Cli, ASlowDriveClaimsItsRotationWithTheTimeOffsetHeld) {
+  testing::ScopedTempDir tmp;
+  const std::string drive =
+      SimulateDrive(tmp.path(), "--frames=20 --seed=1 --time_offset_s=0.03 --speed_mps=1.5");
+  ASSERT_FALSE(drive.empty());
+  const std::string out = tmp.path() + "/out";
+  const RunResult r = CalibrateFromTwoDegrees(drive, out, 1);
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("PARTLY converged"));
+  EXPECT_THAT(r.output, HasSubstr("time offset: held at its start"));
+  const nlohmann::json result = nlohmann::json::parse(testing::ReadFile(out + "/result.json"));
+  EXPECT_TRUE(result["converged"].get<bool>()) << result["reason"];
+  EXPECT_EQ(result["claim"], "partial");
+  EXPECT_EQ(result["held_axes"], nlohmann::json({"z_m", "time_offset_s"})) << result["reason"];
+  EXPECT_LE(result["error"]["rotation_deg"].get<double>(), 0.3) << r.output;
+  EXPECT_LE(std::abs(result["error"]["x_m"].get<double>()), 0.08) << r.output;
+  EXPECT_LE(std::abs(result["error"]["y_m"].get<double>()), 0.08) << r.output;
+  // The held values are the start's, marked in both files.
+  EXPECT_EQ(result["time_offset_s"].get<double>(), 0.0);
+  EXPECT_EQ(result["time_offset_vs_forward"]["rests_on"], "start");
+  EXPECT_THAT(testing::ReadFile(out + "/time_offset.txt"), HasSubstr("# held at the start"));
+  EXPECT_THAT(testing::ReadFile(out + "/calib_velo_to_cam.txt"),
+              HasSubstr("held at the start (not observable in this drive): z_m"));
+  const RunResult check = RunStcalib("check --drive=" + drive + " --init_calib=" + out +
+                                     "/calib_velo_to_cam.txt --out=" + tmp.path() + "/check");
+  EXPECT_NE(check.exit_code, 2) << check.output;
+  EXPECT_THAT(check.output, HasSubstr("time_offset.txt: +0.0000 s")) << check.output;
+}
+
 // A start ±5° on each axis, ±20 cm and δ0 70 ms off, told with --init_uncertainty=5,0.2,0.1: the
 // lattice holds it; the run claims, within 0.3° and 5 cm across travel. The same start with the
 // default uncertainty (±3°, ±5 cm, ±30 ms), which does not hold it, must not claim.

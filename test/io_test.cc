@@ -180,12 +180,19 @@ TEST(KittiWriters, TimeOffsetRoundTripAndBadFilesAreNamed) {
   testing::WriteFile(path, "\n  0.03 \n\n");  // blank lines and spaces are fine
   ASSERT_TRUE(ReadTimeOffset(path, &read).ok());
   EXPECT_EQ(read, 0.03);
+  // A partial claim's note is a comment line, skipped on reading.
+  ASSERT_TRUE(WriteTimeOffset(path, 0.02, "held at the start: not observable in this drive").ok());
+  EXPECT_EQ(testing::ReadFile(path),
+            "0.020000000\n# held at the start: not observable in this drive\n");
+  ASSERT_TRUE(ReadTimeOffset(path, &read).ok());
+  EXPECT_EQ(read, 0.02);
   for (const auto& [text, message] :
        std::vector<std::pair<std::string, std::string>>{{"", "expected one number"},
                                                         {"0.1 0.2\n", "found 2"},
                                                         {"nan\n", "'nan' is not a finite number"},
                                                         {"30ms\n", "'30ms' is not a finite"},
-                                                        {"1.5\n", "beyond ±1 s"}}) {
+                                                        {"1.5\n", "beyond ±1 s"},
+                                                        {"# 0.03\n", "expected one number"}}) {
     testing::WriteFile(path, text);
     const Status status = ReadTimeOffset(path, &read);
     EXPECT_FALSE(status.ok()) << text;

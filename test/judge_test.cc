@@ -176,12 +176,51 @@ TEST(Judge, ListsEveryFailingRuleAndGivesTheFirstAsTheReason) {
   ConvergenceEvidence e = Passing();
   e.final_health = 0.5;
   e.settle_deg = 2.0;
-  e.unobservable_axes = {"z_m"};
+  e.unobservable_axes = {"yaw_deg", "z_m"};
   const Judgement j = Judge(e, ConvergenceOptions());
   int failed = 0;
   for (const RuleOutcome& rule : j.rules) failed += !rule.passed;
   EXPECT_EQ(failed, 3);
   EXPECT_EQ(FirstFailure(e), "observable");
+}
+
+// A partial claim (docs/method.md §7): translation axes and δ the drive does not constrain are
+// held at their start and named; every other rule still guards the claim; a rotation axis is
+// never held.
+TEST(Judge, APartialClaimHoldsTranslationOrTimeOffsetNeverTheRotation) {
+  ConvergenceEvidence e = Passing();
+  e.unobservable_axes = {"x_m", "time_offset_s"};
+  e.time_offset_profile.best_s = 0.1;  // δ held: its profile does not apply
+  Judgement j = Judge(e, ConvergenceOptions());
+  EXPECT_TRUE(j.converged) << j.reason;
+  EXPECT_EQ(j.held_axes, (std::vector<std::string>{"x_m", "time_offset_s"}));
+  EXPECT_EQ(j.reason,
+            "converged, partly: held at the start (not observable in this drive): x_m, "
+            "time_offset_s");
+
+  // δ held by the polish's measurement: δ and the translation along travel (camera z here).
+  e = Passing();
+  e.time_offset_held = true;
+  e.along_travel_axis = 2;
+  e.time_offset_profile.best_s = 0.09;
+  j = Judge(e, ConvergenceOptions());
+  EXPECT_TRUE(j.converged) << j.reason;
+  EXPECT_EQ(j.held_axes, (std::vector<std::string>{"z_m", "time_offset_s"}));
+  // ... and the rules guard what is claimed as before.
+  e.final_health = 0.5;
+  EXPECT_EQ(FirstFailure(e), "health");
+  EXPECT_TRUE(Judge(e, ConvergenceOptions()).held_axes.empty());
+
+  // Not held, δ's profile peaking away refuses; a rotation axis is never held.
+  e = Passing();
+  e.time_offset_profile.best_s = 0.09;
+  EXPECT_EQ(FirstFailure(e), "time_offset_profile");
+  e = Passing();
+  e.unobservable_axes = {"pitch_deg", "time_offset_s"};
+  EXPECT_EQ(FirstFailure(e), "observable");
+
+  // A whole claim holds nothing.
+  EXPECT_TRUE(Judge(Passing(), ConvergenceOptions()).held_axes.empty());
 }
 
 // Hypotheses' per-frame fine scores, made by hand: `base` per frame for the best, the rivals

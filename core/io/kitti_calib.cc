@@ -36,9 +36,9 @@ Status ReadRigid(const std::string& path, Rigid3d* T) {
   return Status::Ok();
 }
 
-KittiCalibFile RigidFile(const Rigid3d& T, bool with_deltas) {
+KittiCalibFile RigidFile(const Rigid3d& T, bool with_deltas, const std::string& note = "") {
   KittiCalibFile file;
-  file.SetText("calib_time", "written by stcalib");
+  file.SetText("calib_time", "written by stcalib" + (note.empty() ? "" : "; " + note));
   file.SetMatrix("R", T.linear());
   file.SetMatrix("T", T.translation());
   if (with_deltas) {
@@ -209,15 +209,16 @@ std::string VeloToCamText(const Rigid3d& T_camera_lidar) {
   return RigidFile(T_camera_lidar, /*with_deltas=*/true).ToString();
 }
 
-Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar) {
-  return RigidFile(T_camera_lidar, /*with_deltas=*/true).Write(path);
+Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar,
+                      const std::string& note) {
+  return RigidFile(T_camera_lidar, /*with_deltas=*/true, note).Write(path);
 }
 
 Status ReadTimeOffset(const std::string& path, double* time_offset_s) {
   std::vector<std::string> lines;
   STCALIB_RETURN_IF_ERROR(ReadLines(path, &lines));
   std::string text;
-  for (const std::string& line : lines) text += line + " ";
+  for (const std::string& line : lines) text += line.substr(0, line.find('#')) + " ";
   std::vector<double> values;
   std::string bad;
   if (!ParseNumbers(text, &values, &bad)) {
@@ -235,10 +236,10 @@ Status ReadTimeOffset(const std::string& path, double* time_offset_s) {
   return Status::Ok();
 }
 
-Status WriteTimeOffset(const std::string& path, double time_offset_s) {
+Status WriteTimeOffset(const std::string& path, double time_offset_s, const std::string& note) {
   char line[64];
   std::snprintf(line, sizeof(line), "%.9f\n", time_offset_s);
-  return WriteTextFile(path, line);
+  return WriteTextFile(path, line + (note.empty() ? "" : "# " + note + "\n"));
 }
 
 Status ReadImuToVelo(const std::string& path, Rigid3d* T_lidar_imu) {

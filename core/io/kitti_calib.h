@@ -62,15 +62,19 @@ Status ReadCamToCam(const std::string& path, CameraCalibration* calibration);
 // calib_velo_to_cam.txt: R (9) and T (3) of T_camera_lidar (LiDAR to unrectified camera 0); R
 // is replaced by the nearest rotation.
 Status ReadVeloToCam(const std::string& path, Rigid3d* T_camera_lidar);
-// Writes R, T (and KITTI's delta_f / delta_c, zero) with 12 significant digits.
-Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar);
+// Writes R, T (and KITTI's delta_f / delta_c, zero) with 12 significant digits; a `note` (which
+// axes a partial claim held) goes into the calib_time line, after "written by stcalib".
+Status WriteVeloToCam(const std::string& path, const Rigid3d& T_camera_lidar,
+                      const std::string& note = "");
 std::string VeloToCamText(const Rigid3d& T_camera_lidar);  ///< what WriteVeloToCam writes
 
 // time_offset.txt (stcalib's, beside its calib_velo_to_cam.txt): δ in seconds, one finite
-// number within ±1 s; blank lines are ignored. Errors name the file and what is wrong.
+// number within ±1 s; blank lines and comments (from # to the end of a line) are ignored. Errors
+// name the file and what is wrong.
 inline constexpr char kTimeOffsetFileName[] = "time_offset.txt";
 Status ReadTimeOffset(const std::string& path, double* time_offset_s);
-Status WriteTimeOffset(const std::string& path, double time_offset_s);  ///< 9 decimals
+// 9 decimals; a `note` follows on a comment line ("# note").
+Status WriteTimeOffset(const std::string& path, double time_offset_s, const std::string& note = "");
 
 // calib_imu_to_velo.txt: R (9) and T (3) of T_lidar_imu.
 Status ReadImuToVelo(const std::string& path, Rigid3d* T_lidar_imu);

@@ -118,13 +118,37 @@ RuleOutcome InsideBounds(const ConvergenceEvidence& e, const ConvergenceOptions&
   return {"inside_bounds", false, text};
 }
 
+bool IsRotationAxis(const std::string& axis) {
+  return axis == kAxisNames[0] || axis == kAxisNames[1] || axis == kAxisNames[2];
+}
+
+bool HoldsTimeOffset(const ConvergenceEvidence& e) {
+  return e.time_offset_held || std::count(e.unobservable_axes.begin(), e.unobservable_axes.end(),
+                                          std::string(kAxisNames[6])) > 0;
+}
+
+std::string JoinAxes(const std::vector<std::string>& axes) {
+  std::string text;
+  for (const std::string& a : axes) text += (text.empty() ? "" : ", ") + a;
+  return text;
+}
+
+// A rotation axis the drive does not constrain refuses the claim; translation axes and δ are
+// held at their start values instead (a partial claim).
 RuleOutcome Observable(const ConvergenceEvidence& e, const ConvergenceOptions&) {
   if (e.unobservable_axes.empty()) return {"observable", true, "every axis"};
-  std::string axes;
-  for (const std::string& a : e.unobservable_axes) axes += (axes.empty() ? "" : ", ") + a;
+  std::vector<std::string> rotation;
+  for (const std::string& a : e.unobservable_axes) {
+    if (IsRotationAxis(a)) rotation.push_back(a);
+  }
+  if (rotation.empty()) {
+    return {"observable", true,
+            "the rotation; held at their start values (not observable in this drive): " +
+                JoinAxes(e.unobservable_axes)};
+  }
   return {"observable", false,
-          "not observable in this drive: " + axes +
-              " (held at their start values; the scene does not constrain them)"};
+          "not observable in this drive: " + JoinAxes(e.unobservable_axes) +
+              " (the scene does not constrain the rotation, which is never held)"};
 }
 
 RuleOutcome RotationProfiles(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
@@ -148,13 +172,18 @@ RuleOutcome RotationProfiles(const ConvergenceEvidence& e, const ConvergenceOpti
 
 RuleOutcome TimeOffsetProfileRule(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
   const TimeOffsetProfile& p = e.time_offset_profile;
+  if (HoldsTimeOffset(e)) {
+    return {kTimeOffsetRule, true,
+            "δ held at its start: this drive does not separate it from the translation along "
+            "travel"};
+  }
   if (!e.time_offset_estimated || p.scores.empty()) {
-    return {"time_offset_profile", true, "not profiled"};
+    return {kTimeOffsetRule, true, "not profiled"};
   }
   const double away_s = p.best_s - e.time_offset_s;
   const std::string text =
       Format("the last frames' score over δ peaks %+.1f ms away", 1000 * away_s);
-  return {"time_offset_profile", std::abs(away_s) <= o.max_profile_offset_s, text};
+  return {kTimeOffsetRule, std::abs(away_s) <= o.max_profile_offset_s, text};
 }
 
 RuleOutcome TranslationWithinPrior(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
@@ -264,6 +293,7 @@ std::vector<std::string> ConvergenceRuleNames() {
 }
 
 Judgement Judge(const ConvergenceEvidence& evidence, const ConvergenceOptions& options) {
+  const ConvergenceEvidence& e = evidence;
   Judgement judgement;
   for (Rule rule : kRules) {
     judgement.rules.push_back(rule(evidence, options));
@@ -273,7 +303,20 @@ Judgement Judge(const ConvergenceEvidence& evidence, const ConvergenceOptions& o
     }
   }
   judgement.converged = judgement.reason.empty();
-  if (judgement.converged) judgement.reason = "converged";
+  if (!judgement.converged) return judgement;
+  for (int k = 0; k < kNumAxes; ++k) {
+    const std::string axis = kAxisNames[k];
+    const bool unobservable =
+        std::count(e.unobservable_axes.begin(), e.unobservable_axes.end(), axis) > 0;
+    if (unobservable || (k == kNumAxes - 1 && HoldsTimeOffset(e)) ||
+        (k >= 3 && k < 6 && e.time_offset_held && k - 3 == e.along_travel_axis)) {
+      judgement.held_axes.push_back(axis);
+    }
+  }
+  judgement.reason = judgement.held_axes.empty()
+                         ? "converged"
+                         : "converged, partly: held at the start (not observable in this drive): " +
+                               JoinAxes(judgement.held_axes);
   return judgement;
 }
 
@@ -281,9 +324,27 @@ ConvergenceEvidence GatherEvidence(const OnlineCalibrator& calibrator,
                                    const std::vector<FrameReport>& reports,
                                    const CalibrationState& initial,
                                    const OnlineCalibratorOptions& online,
-                                   const ConvergenceOptions& options, ConvergenceVerdict* verdict) {
+                                   const ConvergenceOptions& options, ConvergenceVerdict* verdict,
+                                   bool hold_time_offset) {
   ConvergenceEvidence e;
   verdict->estimate = calibrator.state();
+  if (hold_time_offset) {
+    // δ goes back to its start, and so does the translation along travel, which rests on its
+    // prior as δ does (the camera axis the last update's direction of travel lies most along).
+    e.time_offset_held = true;
+    verdict->estimate.time_offset_s = initial.time_offset_s;
+    for (auto it = reports.rbegin(); it != reports.rend(); ++it) {
+      if (it->skipped || !it->ran_update()) continue;
+      const Eigen::Vector3d forward = it->refine.forward_camera;
+      if (forward.allFinite() && forward.squaredNorm() > 0) {
+        int axis = 0;
+        forward.cwiseAbs().maxCoeff(&axis);
+        verdict->estimate.T_camera_lidar.translation()[axis] =
+            initial.T_camera_lidar.translation()[axis];
+      }
+      break;
+    }
+  }
 
   // Aliasing guard over δ and the rotation-axis profiles, on the refinement's frames (the
   // longest window the calibrator keeps: a sharp score's profile over 3 frames is noisy), scored
@@ -387,21 +448,15 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                                     const std::vector<FrameReport>& reports,
                                     const CalibrationState& initial,
                                     const OnlineCalibratorOptions& online,
-                                    const ConvergenceOptions& options) {
+                                    const ConvergenceOptions& options, bool hold_time_offset) {
   ConvergenceVerdict verdict;
   ConvergenceEvidence evidence =
-      GatherEvidence(calibrator, reports, initial, online, options, &verdict);
+      GatherEvidence(calibrator, reports, initial, online, options, &verdict, hold_time_offset);
   Judgement judgement = Judge(evidence, options);
   // The jackknife (a refinement per block of frames) and the check on texture-suppressed maps (a
   // health score per window) are measured only when the rules before them pass.
   auto only_these_fail = [&](std::initializer_list<const char*> names) {
-    for (const RuleOutcome& rule : judgement.rules) {
-      if (rule.passed) continue;
-      bool listed = false;
-      for (const char* name : names) listed = listed || rule.name == name;
-      if (!listed) return false;
-    }
-    return true;
+    return OnlyTheseFail(judgement.rules, names);
   };
   // The refinement's frames, as GatherEvidence read them for the profiles.
   const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
@@ -426,6 +481,7 @@ ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
     judgement = Judge(evidence, options);
   }
   verdict.converged = judgement.converged;
+  verdict.held_axes = judgement.held_axes;
   verdict.reason = judgement.reason;
   verdict.rules = judgement.rules;
   return verdict;
@@ -506,6 +562,18 @@ ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool ti
   return reported;
 }
 
+// Whether every rule that failed in `rules` is one of `names`.
+bool OnlyTheseFail(const std::vector<RuleOutcome>& rules,
+                   std::initializer_list<const char*> names) {
+  for (const RuleOutcome& rule : rules) {
+    if (rule.passed) continue;
+    bool listed = false;
+    for (const char* name : names) listed = listed || rule.name == name;
+    if (!listed) return false;
+  }
+  return true;
+}
+
 ConvergenceVerdict VerdictAfterPolish(const ConvergenceVerdict& online,
                                       const ConvergenceVerdict& polished) {
   if (polished.converged) return polished;
@@ -533,6 +601,33 @@ ConvergenceVerdict JudgeAndPolish(OnlineCalibrator* calibrator,
   if (polish == nullptr) return verdict;
   *polish = FrameReport();
   polish->before = polish->after = calibrator->state();
+  // Refused on δ alone (its profile peaks away from the estimate): the polish, which frees δ and
+  // the forward translation together, measures whether this drive separates them. Where it does
+  // not (a slow drive: the LiDAR moves millimetres over δ), δ and the translation along travel
+  // are held at their start and the rest is judged again: a partial claim, with every rule
+  // unchanged for the axes claimed. Where it does, the refusal stands.
+  if (!verdict.converged && online.refine.estimate_time_offset &&
+      OnlyTheseFail(verdict.rules, {kTimeOffsetRule, kJackknifeRule, kSuppressedCheckRule}) &&
+      !OnlyTheseFail(verdict.rules, {kJackknifeRule, kSuppressedCheckRule})) {
+    const CalibrationState online_state = calibrator->state();
+    const FrameReport probe = calibrator->Polish();
+    calibrator->SetState(online_state);  // a measurement only: the online estimate stays
+    if (probe.time_forward.measured && !probe.time_forward.separated) {
+      ConvergenceVerdict held =
+          JudgeConvergence(*calibrator, reports, initial, online, options, true);
+      if (held.converged) {
+        polish->reason =
+            "polish: measured δ against the translation along travel only: not separated in "
+            "this drive (δ std " +
+            std::to_string(1000 * probe.time_forward.time_offset_std_s) +
+            " ms with it free), so both are held at the start and the online estimate is kept";
+        polish->time_forward = probe.time_forward;
+        held.time_forward = probe.time_forward;
+        held.time_offset_observable = false;
+        return held;
+      }
+    }
+  }
   if (!verdict.converged) {
     polish->reason = "polish: not run (the online estimate did not converge)";
     return verdict;

@@ -77,6 +77,9 @@ struct ConvergenceEvidence {
   bool time_offset_estimated = true;
   double time_offset_s = 0, time_offset_bound_s = 0;  ///< the estimate's δ and its bound [s]
   std::vector<std::string> unobservable_axes;  ///< axes the last refinement could not pin down
+  // δ is held at its start: the polish, with the forward translation free, could not separate
+  // the two in this drive (JudgeAndPolish), so the δ rules do not apply and the claim is partial.
+  bool time_offset_held = false;
   std::array<RotationAxisProfile, 3> rotation_profiles;
   TimeOffsetProfile time_offset_profile;
   Eigen::Vector3d translation_move_m = Eigen::Vector3d::Zero();  ///< estimate − start, camera
@@ -104,9 +107,15 @@ struct RuleOutcome {
   std::string detail;
 };
 
+// A claim may be partial (docs/method.md §7): every rule passes for the rotation and the axes it
+// observed, while δ or translation axes the drive does not constrain keep their start values.
+// The rotation is never held: a rotation axis the drive does not constrain refuses the claim.
 struct Judgement {
-  bool converged = false;
-  std::string reason;              ///< "converged" or "not converged: " + the first failure
+  bool converged = false;  ///< a claim, whole or partial
+  // The axes held at their start values (kAxisNames), in axis order: a partial claim when any.
+  std::vector<std::string> held_axes;
+  // "converged", "converged, partly: ..." or "not converged: " + the first failure.
+  std::string reason;
   std::vector<RuleOutcome> rules;  ///< every rule, in the order judged
 };
 
@@ -119,10 +128,14 @@ Judgement Judge(const ConvergenceEvidence& evidence, const ConvergenceOptions& o
 inline constexpr const char* kJackknifeRule = "rotation_jackknife";
 inline constexpr const char* kDominanceRule = "one_hypothesis_dominates";
 inline constexpr const char* kSuppressedCheckRule = "suppressed_maps_check";
+inline constexpr const char* kTimeOffsetRule = "time_offset_profile";
+// Whether every rule that failed in `rules` is one of `names`.
+bool OnlyTheseFail(const std::vector<RuleOutcome>& rules, std::initializer_list<const char*> names);
 
 struct ConvergenceVerdict {
-  bool converged = false;
-  std::string reason;         ///< "converged" or "not converged: …"
+  bool converged = false;              ///< a claim, whole or partial (Judgement)
+  std::vector<std::string> held_axes;  ///< held at their start values: a partial claim when any
+  std::string reason;         ///< "converged", "converged, partly: …" or "not converged: …"
   CalibrationState estimate;  ///< the final estimate, unobservable axes back at the start
   // The axes held at their start because the last refinement could not pin them down (not the
   // forward translation and δ resting on the forward prior: see ReportUncertainty).
@@ -201,19 +214,23 @@ TranslationMove TranslationMoveBeyondPrior(const CalibrationState& initial,
 
 // `reports` are all of the run's frame reports in order; `initial` the run's start. Gathers the
 // evidence (and the verdict's other fields: profiles, held axes, refinement spread) from the
-// calibrator; the suppressed-map check is left unmeasured.
+// calibrator; the suppressed-map check is left unmeasured. With `hold_time_offset` δ and the
+// translation along travel go back to their start values before anything is measured
+// (ConvergenceEvidence::time_offset_held).
 ConvergenceEvidence GatherEvidence(const OnlineCalibrator& calibrator,
                                    const std::vector<FrameReport>& reports,
                                    const CalibrationState& initial,
                                    const OnlineCalibratorOptions& online,
-                                   const ConvergenceOptions& options, ConvergenceVerdict* verdict);
+                                   const ConvergenceOptions& options, ConvergenceVerdict* verdict,
+                                   bool hold_time_offset = false);
 
 // GatherEvidence, then Judge; the suppressed-map check is measured when every other rule passed.
 ConvergenceVerdict JudgeConvergence(const OnlineCalibrator& calibrator,
                                     const std::vector<FrameReport>& reports,
                                     const CalibrationState& initial,
                                     const OnlineCalibratorOptions& online,
-                                    const ConvergenceOptions& options);
+                                    const ConvergenceOptions& options,
+                                    bool hold_time_offset = false);
 
 // The verdict after a polish: `polished` (the polished estimate's) when it converged; else the
 // online one, refused when it had converged: an estimate whose refinement over its own frames

@@ -166,6 +166,12 @@ Status SimulatorOptions::Validate() const {
     return Status::Error("--dynamic_objects must be between 0 and 200, got " +
                          std::to_string(dynamic_objects));
   }
+  if (!(speed_mps == 0 || (speed_mps >= 0.5 && speed_mps <= SimTrajectory::kMaxSpeedMps))) {
+    return Status::Error(
+        "--speed_mps must be 0 (the default profile) or between 0.5 and 15 m/s, "
+        "got " +
+        std::to_string(speed_mps));
+  }
   if (!(std::abs(distortion_k1) <= 1.0)) {
     return Status::Error("--distortion_k1 must be within ±1, got " + std::to_string(distortion_k1));
   }
@@ -200,7 +206,7 @@ Simulator::Simulator(const SimulatorOptions& options) : options_(options) {
       SimRoad::Generate(-80.0, SimTrajectory::kMaxSpeedMps * duration + 150.0,
                         /*with_turns=*/true, &road_rng));
   std::mt19937_64 trajectory_rng = MakeRng(seed, kTrajectory);
-  trajectory_ = std::make_unique<SimTrajectory>(road_.get(), &trajectory_rng);
+  trajectory_ = std::make_unique<SimTrajectory>(road_.get(), &trajectory_rng, options.speed_mps);
   std::mt19937_64 scene_rng = MakeRng(seed, kScene);
   scene_ = std::make_unique<Scene>(Scene::Build(options.scene, options.dynamic_objects, road_.get(),
                                                 trajectory_.get(), &scene_rng));

@@ -47,6 +47,9 @@ struct SimulatorOptions {
   // Radial distortion k1 of a raw camera image (0: rectified images, as KITTI's); the drive's
   // calib_cam_to_cam.txt then says so (distortion_model_02, K_02, D_02).
   double distortion_k1 = 0.0;
+  // Mean speed of the ego vehicle [m/s]; 0: a random 10–13 m/s. A slow drive (walking pace)
+  // moves too little over δ for the time offset to be seen.
+  double speed_mps = 0.0;
   NavigationErrorOptions oxts_error;  ///< the oxts packets' drift and noise
 
   Status Validate() const;

@@ -4,7 +4,8 @@
 
 namespace stcalib::sim {
 
-SimTrajectory::SimTrajectory(const SimRoad* road, std::mt19937_64* rng) : road_(road) {
+SimTrajectory::SimTrajectory(const SimRoad* road, std::mt19937_64* rng, double mean_speed_mps)
+    : road_(road) {
   std::uniform_real_distribution<double> mean(10.0, 13.0), amplitude(1.0, 2.0), period(6.0, 12.0),
       phase(0.0, 2 * M_PI);
   v_mean_ = mean(*rng);
@@ -14,6 +15,10 @@ SimTrajectory::SimTrajectory(const SimRoad* road, std::mt19937_64* rng) : road_(
   roll_phase_ = phase(*rng);
   pitch_phase_ = phase(*rng);
   bounce_phase_ = phase(*rng);
+  if (mean_speed_mps > 0) {  // after every draw: the rest of the drive stays as the seed makes it
+    v_amplitude_ *= mean_speed_mps / v_mean_;
+    v_mean_ = mean_speed_mps;
+  }
 }
 
 double SimTrajectory::Speed(double t) const {

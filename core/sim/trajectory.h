@@ -8,11 +8,12 @@
 namespace stcalib::sim {
 
 // The ego vehicle's true motion: it follows the road centreline with a smooth speed profile
-// (8–15 m/s), leans in turns and pitches under acceleration, with small suspension motion.
+// (8–15 m/s, or around `mean_speed_mps` when it is positive, with the same relative swing), leans
+// in turns and pitches under acceleration, with small suspension motion.
 // Time t is in seconds from the start of the drive. The world is east-north-up (x east).
 class SimTrajectory {
  public:
-  SimTrajectory(const SimRoad* road, std::mt19937_64* rng);
+  SimTrajectory(const SimRoad* road, std::mt19937_64* rng, double mean_speed_mps = 0);
 
   double ArcLength(double t_s) const;  ///< s(t) [m], s(0) = 0
   double Speed(double t_s) const;      ///< ds/dt [m/s]
