@@ -15,6 +15,7 @@
 #include "apps/commands.h"
 #include "apps/flags.h"
 #include "apps/plot.h"
+#include "apps/report.h"
 #include "core/io/image.h"
 #include "core/io/kitti_calib.h"
 #include "core/io/text.h"
@@ -407,6 +408,9 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
                                                     ? nlohmann::json(refine.std_dev[kTime])
                                                     : nlohmann::json(nullptr)}};
   const Eigen::Vector3d rpy_deg = MountRollPitchYawDeg(outcome->estimate.T_camera_lidar.linear());
+  const Eigen::Vector3d start_rpy_deg =
+      MountRollPitchYawDeg(outcome->initial.T_camera_lidar.linear());
+  const Eigen::Vector3d start_t = outcome->initial.T_camera_lidar.translation();
   nlohmann::json rules_json = nlohmann::json::array();
   for (const RuleOutcome& rule : verdict.rules) {
     rules_json.push_back({{"name", rule.name}, {"passed", rule.passed}, {"detail", rule.detail}});
@@ -501,6 +505,14 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"reference", outcome->reference},
       {"motion", outcome->motion},
       {"initial_error", ErrorJson(outcome->initial_error)},
+      {"start",
+       {{"rpy_deg",
+         {{"roll", start_rpy_deg.x()}, {"pitch", start_rpy_deg.y()}, {"yaw", start_rpy_deg.z()}}},
+        {"translation_m", {{"x", start_t.x()}, {"y", start_t.y()}, {"z", start_t.z()}}},
+        {"time_offset_s", outcome->initial.time_offset_s}}},
+      {"stcalib_version", StcalibVersion()},
+      {"command", CommandLineText()},
+      {"input", job.bag.bag_dir.empty() ? job.drive_dir : job.bag.bag_dir},
   };
   if (outcome->has_truth) {
     result["error"] = ErrorJson(outcome->error);
@@ -514,7 +526,8 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       "frame,accepted,from_hypotheses,points,gray_rate,health,roll_deg,pitch_deg,yaw_deg,x_m,y_m,z_"
       "m,"
       "time_offset_s,rotation_error_deg,translation_error_m,time_offset_error_s,search_ms,refine_"
-      "ms,phase,reason\n";
+      "ms,phase,reason,roll_std_deg,pitch_std_deg,yaw_std_deg,x_std_m,y_std_m,z_std_m,time_offset_"
+      "std_s\n";
   std::vector<double> xs, rot_err, trans_err_cm, dt_ms, roll_e, pitch_e, yaw_e;
   for (const FrameReport& r : outcome->reports) {
     const CalibrationError e = ComputeCalibrationError(r.after, outcome->reference_state);
@@ -528,7 +541,17 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
         r.after.T_camera_lidar.translation().y(), r.after.T_camera_lidar.translation().z(),
         r.after.time_offset_s, e.rotation_deg, e.translation_norm_m, e.time_offset_s, r.search_ms,
         r.refine_ms);
-    csv += row + PhaseName(r.phase) + "," + Csv(r.reason) + "\n";
+    csv += row + PhaseName(r.phase) + "," + Csv(r.reason);
+    // The frame's refinement std per axis (empty without one): the report's bands.
+    const bool has_std = r.ran_update() && r.refine.usable && r.refine.covariance_ok;
+    for (int k = 0; k < kNumAxes; ++k) {
+      char value[32] = "";
+      if (has_std) {
+        std::snprintf(value, sizeof(value), "%.6g", r.refine.std_dev[k]);  // deg, m, s
+      }
+      csv += std::string(",") + value;
+    }
+    csv += "\n";
     xs.push_back(r.frame);
     rot_err.push_back(e.rotation_deg);
     roll_e.push_back(e.roll_deg);
@@ -599,11 +622,34 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
         "overlay_after.png",
         DrawEdgeOverlay(image, *last_frame, outcome->estimate, "after: estimate"));
   }
+  // The report's strip: up to kStripFrames frames spread over the refinement's window, each at
+  // the start and at the estimate.
+  constexpr size_t kStripFrames = 4;
+  fs::remove_all(out + "/frames", ec);
+  const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
+  for (size_t k = 0; k < std::min(kStripFrames, recent.size()); ++k) {
+    const size_t pick =
+        recent.size() <= kStripFrames ? k : k * (recent.size() - 1) / (kStripFrames - 1);
+    const CalibrationFrame& frame = *recent[pick];
+    cv::Mat image;
+    status = drive.LoadImage(frame.index, &image);
+    if (!status.ok()) return fail(status);
+    const std::string index = std::to_string(frame.index);
+    pictures.emplace_back(
+        "frames/start_" + index + ".png",
+        DrawEdgeOverlay(image, frame, outcome->initial, "frame " + index + " at the start"));
+    pictures.emplace_back(
+        "frames/estimate_" + index + ".png",
+        DrawEdgeOverlay(image, frame, outcome->estimate, "frame " + index + " at the estimate"));
+  }
+  fs::create_directories(out + "/frames", ec);
   for (const auto& [name, picture] : pictures) {
     status = WriteImage(out + "/" + name, picture);
     if (!status.ok()) return fail(status);
     outcome->pictures.push_back(out + "/" + name);
   }
+  status = WriteRunReport(out);
+  if (!status.ok()) return fail(status);
   return verdict_code();
 }
 

@@ -28,6 +28,11 @@ int RunDemo();
 int RunEvalTemporal();
 int RunCheck();
 int RunConvert();
+int RunReport();
+// The one argument after the subcommand that is not a flag (`report RUN_DIR`); empty if none.
+const std::string& PositionalArgument();
+// The command line as given (argv joined by spaces), for the outputs that name it.
+const std::string& CommandLineText();
 
 // Prints "stcalib <command>: error: <message>" to stderr and returns kExitFailure.
 int ReportError(const std::string& command, const Status& status);

@@ -30,6 +30,16 @@ std::string DefaultAsWritten(const gflags::CommandLineFlagInfo& info) {
   return text;
 }
 
+std::string& Positional() {
+  static std::string positional;
+  return positional;
+}
+
+std::string& CommandLine() {
+  static std::string command_line;
+  return command_line;
+}
+
 struct Subcommand {
   const char* name;
   const char* synopsis;
@@ -125,6 +135,12 @@ const std::vector<Subcommand>& Subcommands() {
        "times, odometry from the oxts, /tf_static; calibrate --bag reads it back",
        &RunConvert,
        {"drive", "calib_dir", "bag"}},
+      {"report",
+       "RUN_DIR",
+       "report.html of a calibrate run folder, written again from its files (result.json, "
+       "per_frame.csv, the pictures)",
+       &RunReport,
+       {}},
       {"demo",
        "[--out=DIR] [--seed=S]",
        "simulate a drive (true time offset +30 ms), calibrate it from +-2 deg / +-5 cm, print "
@@ -156,6 +172,7 @@ int Main(int argc, char** argv) {
     return argc < 2 ? kExitUsage : kExitOk;
   }
   const std::string name = argv[1];
+  for (int i = 0; i < argc; ++i) CommandLine() += (i ? " " : "") + std::string(argv[i]);
   const Subcommand* command = nullptr;
   for (const Subcommand& s : Subcommands()) {
     if (name == s.name) command = &s;
@@ -187,13 +204,19 @@ int Main(int argc, char** argv) {
   char** args_data = args.data();
   gflags::SetUsageMessage(std::string("stcalib ") + command->name + " " + command->synopsis);
   gflags::ParseCommandLineFlags(&args_count, &args_data, /*remove_flags=*/true);
-  if (args_count > 1) {
+  // `report` takes its run folder as the one argument that is not a flag.
+  if (name == "report" && args_count == 2) {
+    Positional() = args_data[1];
+  } else if (args_count > 1) {
     return UsageError(command->name, std::string("unexpected argument '") + args_data[1] + "'");
   }
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   return command->run();
 }
+
+const std::string& PositionalArgument() { return Positional(); }
+const std::string& CommandLineText() { return CommandLine(); }
 
 }  // namespace stcalib::cli
 

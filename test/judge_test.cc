@@ -197,6 +197,10 @@ TEST(Judge, APartialClaimHoldsTranslationOrTimeOffsetNeverTheRotation) {
   EXPECT_EQ(j.reason,
             "converged, partly: held at the start (not observable in this drive): x_m, "
             "time_offset_s");
+  // δ held holds the translation along travel (camera z here) with it.
+  e.along_travel_axis = 2;
+  EXPECT_EQ(Judge(e, ConvergenceOptions()).held_axes,
+            (std::vector<std::string>{"x_m", "z_m", "time_offset_s"}));
 
   // δ held by the polish's measurement: δ and the translation along travel (camera z here).
   e = Passing();

@@ -309,7 +309,7 @@ Judgement Judge(const ConvergenceEvidence& evidence, const ConvergenceOptions& o
     const bool unobservable =
         std::count(e.unobservable_axes.begin(), e.unobservable_axes.end(), axis) > 0;
     if (unobservable || (k == kNumAxes - 1 && HoldsTimeOffset(e)) ||
-        (k >= 3 && k < 6 && e.time_offset_held && k - 3 == e.along_travel_axis)) {
+        (k >= 3 && k < 6 && HoldsTimeOffset(e) && k - 3 == e.along_travel_axis)) {
       judgement.held_axes.push_back(axis);
     }
   }
@@ -399,8 +399,16 @@ ConvergenceEvidence GatherEvidence(const OnlineCalibrator& calibrator,
   e.rotation_moved_deg =
       RotationErrorDeg(verdict->estimate.T_camera_lidar.linear(), initial.T_camera_lidar.linear());
   if (!used.empty() && !verdict->unobservable_axes.empty()) {
-    verdict->estimate =
-        KeepObservableAxes(initial, verdict->estimate, last_update.refine.observable);
+    std::array<bool, kNumAxes> keep = last_update.refine.observable;
+    // δ held: the translation along travel, which rests on its prior as δ does, goes back too.
+    const Eigen::Vector3d forward = last_update.refine.forward_camera;
+    if (!keep[6] && online.refine.estimate_time_offset && forward.allFinite() &&
+        forward.squaredNorm() > 0) {
+      int axis = 0;
+      forward.cwiseAbs().maxCoeff(&axis);
+      keep[3 + axis] = false;
+    }
+    verdict->estimate = KeepObservableAxes(initial, verdict->estimate, keep);
   }
 
   for (auto it = updates.rbegin();
@@ -649,6 +657,21 @@ ConvergenceVerdict JudgeAndPolish(OnlineCalibrator* calibrator,
   // Polish() marks the pair separated only when it estimated δ and applied the pair's move.
   verdict.time_forward = polish->time_forward;
   verdict.time_offset_observable = verdict.refine.observable[6] && verdict.time_forward.separated;
+  // A claim whose δ the drive does not see at all (not separated, and with the forward
+  // translation free δ's std is over kMaxUnseparatedTimeOffsetStdS) would write the forward
+  // prior's echo as δ: δ and the translation along travel are held at the start instead, and
+  // the rest judged again there (a partial claim, or a refusal if the rest does not hold).
+  const TimeForwardPair& pair = polish->time_forward;
+  if (verdict.converged && online.refine.estimate_time_offset && pair.measured && !pair.separated &&
+      pair.time_offset_std_s > kMaxUnseparatedTimeOffsetStdS &&
+      std::count(verdict.held_axes.begin(), verdict.held_axes.end(), std::string(kAxisNames[6])) ==
+          0) {
+    ConvergenceVerdict held =
+        JudgeConvergence(*calibrator, reports, initial, online, options, true);
+    held.time_forward = pair;
+    held.time_offset_observable = false;
+    return held;
+  }
   return verdict;
 }
 

@@ -129,6 +129,12 @@ inline constexpr const char* kJackknifeRule = "rotation_jackknife";
 inline constexpr const char* kDominanceRule = "one_hypothesis_dominates";
 inline constexpr const char* kSuppressedCheckRule = "suppressed_maps_check";
 inline constexpr const char* kTimeOffsetRule = "time_offset_profile";
+// A claim holds δ (and the translation along travel) at the start when the polish did not
+// separate them and δ's std with the forward translation free exceeds this [s]: the drive does
+// not see δ, whose estimate then only echoes the forward prior. Measured on the polish's pair:
+// 5.8–7.8 ms on the development suite's claims at 8–15 m/s (δ then 3–6 ms off, kept), 24–28 ms
+// on simulated drives at 1.5 m/s (δ 30 ms off). docs/tuning.md#unseparated-time-offset
+inline constexpr double kMaxUnseparatedTimeOffsetStdS = 0.015;
 // Whether every rule that failed in `rules` is one of `names`.
 bool OnlyTheseFail(const std::vector<RuleOutcome>& rules, std::initializer_list<const char*> names);
 
