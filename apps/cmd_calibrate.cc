@@ -46,37 +46,6 @@ nlohmann::json ErrorJson(const CalibrationError& e) {
           {"time_offset_s", e.time_offset_s}};
 }
 
-cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
-                        const CalibrationState& state, const std::string& title) {
-  cv::Mat canvas;
-  image.convertTo(canvas, CV_8UC3, 0.55);
-  // What the score reads: a vertical LiDAR edge point against near-vertical image edges, a
-  // horizontal one against near-horizontal ones (the frame's smoothed distance maps).
-  for (size_t i = 0; i < frame.size(); ++i) {
-    Eigen::Vector2d pixel;
-    if (!ProjectFramePoint(frame, state, i, &pixel) || !frame.camera.InImage(pixel)) continue;
-    const int u = static_cast<int>(std::lround(pixel.x())),
-              v = static_cast<int>(std::lround(pixel.y()));
-    const cv::Mat& distance_px = frame.distance_px[static_cast<int>(frame.kinds[i])];
-    const bool near = !distance_px.empty() && distance_px.at<float>(v, u) <= 2.0f;
-    cv::circle(canvas, cv::Point(u, v), 2, near ? cv::Scalar(60, 255, 60) : cv::Scalar(40, 40, 255),
-               cv::FILLED);
-  }
-  cv::putText(canvas, title, cv::Point(10, 22), cv::FONT_HERSHEY_SIMPLEX, 0.6,
-              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-  // Legend, bottom left: what the two colours mean.
-  const int y = canvas.rows - 12;
-  cv::circle(canvas, cv::Point(14, y - 4), 4, cv::Scalar(60, 255, 60), cv::FILLED);
-  cv::putText(canvas, "LiDAR edge point within 2 px of an image edge of its direction",
-              cv::Point(24, y), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1,
-              cv::LINE_AA);
-  cv::circle(canvas, cv::Point(14, y - 22), 4, cv::Scalar(40, 40, 255), cv::FILLED);
-  cv::putText(canvas, "LiDAR edge point farther from every image edge of its direction",
-              cv::Point(24, y - 18), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1,
-              cv::LINE_AA);
-  return canvas;
-}
-
 std::string Csv(const std::string& s) { return "\"" + s + "\""; }
 
 // What the final refinement (OnlineCalibrator::Polish) did.

@@ -1,4 +1,5 @@
-// stcalib report RUN_DIR: report.html of a calibrate run folder, written again (docs/output.md).
+// stcalib report RUN_DIR: report.html of a calibrate or check run folder, written again
+// (docs/output.md).
 #include <cstdio>
 
 #include "apps/commands.h"

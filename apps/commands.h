@@ -6,6 +6,7 @@
 #include "core/features/image_features.h"
 #include "core/io/bag_drive.h"
 #include "core/io/drive.h"
+#include "core/score/calibration_frame.h"
 #include "core/types/calibration.h"
 #include "core/types/status.h"
 
@@ -33,6 +34,11 @@ int RunReport();
 const std::string& PositionalArgument();
 // The command line as given (argv joined by spaces), for the outputs that name it.
 const std::string& CommandLineText();
+
+// The frame's LiDAR edge points projected at `state` on its image (darkened), green where within
+// 2 px of an image edge of their direction, red elsewhere, with `title` and a legend.
+cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
+                        const CalibrationState& state, const std::string& title);
 
 // Prints "stcalib <command>: error: <message>" to stderr and returns kExitFailure.
 int ReportError(const std::string& command, const Status& status);

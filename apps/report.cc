@@ -191,6 +191,140 @@ std::string Panel(const std::string& title, const std::string& unit, const std::
   return svg + "</svg>";
 }
 
+const char kHead[] =
+    "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+    "<title>stcalib report</title><style>"
+    "body{font-family:sans-serif;margin:24px;max-width:1400px}"
+    "table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 8px;"
+    "text-align:left;vertical-align:top}th{background:#eee}"
+    ".whole{color:#060}.partial{color:#a60}.none{color:#b00}.held{color:#a60;font-weight:bold}"
+    ".failed{background:#fdd}.strip{overflow-x:auto}.strip figure{margin:4px 0 12px 0}"
+    ".strip img{display:block}"
+    "svg text{font-size:12px}svg .title{font-weight:bold}svg .zero{stroke:#999}"
+    "svg .band{opacity:0.2}svg polyline{stroke-width:1.5}"
+    "</style></head><body>\n";
+
+// Marks the page once every image decoded (read by the browser test; nothing is fetched).
+const char kTail[] =
+    "<script>window.addEventListener('load',function(){var i=document.images,n=0;"
+    "for(var k=0;k<i.length;k++){if(i[k].complete&&i[k].naturalWidth>0)n++;}"
+    "document.body.setAttribute('data-images',n+'/'+i.length);});</script>\n</body></html>\n";
+
+// The frames/<prefix>F.png pictures of a run folder, in frame order, with each frame's
+// captions, one figure per picture.
+Status FrameStrip(const std::string& run_dir, const std::vector<std::string>& prefixes,
+                  const std::vector<std::string>& captions, std::string* html) {
+  std::vector<std::string> frames;
+  if (fs::is_directory(run_dir + "/frames")) {
+    for (const auto& entry : fs::directory_iterator(run_dir + "/frames")) {
+      const std::string name = entry.path().filename().string();
+      const std::string& first = prefixes.front();
+      if (name.rfind(first, 0) == 0 && entry.path().extension() == ".png") {
+        frames.push_back(name.substr(first.size(), name.size() - first.size() - 4));
+      }
+    }
+  }
+  std::sort(frames.begin(), frames.end(),
+            [](const std::string& a, const std::string& b) { return std::stoi(a) < std::stoi(b); });
+  for (const std::string& frame : frames) {
+    *html += "<div class=\"strip\">";
+    for (size_t k = 0; k < prefixes.size(); ++k) {
+      std::string tag;
+      const std::string caption = "frame " + frame + ", " + captions[k];
+      STCALIB_RETURN_IF_ERROR(
+          ImageTag(run_dir + "/frames/" + prefixes[k] + frame + ".png", caption, &tag));
+      *html += "<figure>" + tag + "<figcaption>" + Escape(caption) + "</figcaption></figure>";
+    }
+    *html += "</div>";
+  }
+  if (frames.empty()) *html += "<p>No frame was used: nothing to draw.</p>";
+  return Status::Ok();
+}
+
+std::string RunSection(const json& run) {
+  return "<section id=\"run\"><h2>Run</h2><table><tr><th>command</th><td><code>" +
+         Escape(run["command"].get<std::string>()) + "</code></td></tr><tr><th>input</th><td>" +
+         Escape(run["input"].get<std::string>()) + "</td></tr><tr><th>version</th><td>" +
+         Escape(run["stcalib_version"].get<std::string>()) + "</td></tr></table></section>\n";
+}
+
+// The keys of `object` among `keys` that it lacks, comma-separated; empty when none.
+std::string MissingKeys(const json& object, std::initializer_list<const char*> keys) {
+  std::string missing;
+  for (const char* key : keys) {
+    if (!object.contains(key)) missing += std::string(missing.empty() ? "" : ", ") + key;
+  }
+  return missing;
+}
+
+Status ReadJsonObject(const std::string& path, json* object) {
+  std::string text;
+  STCALIB_RETURN_IF_ERROR(ReadBytes(path, &text));
+  *object = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (object->is_discarded() || !object->is_object()) {
+    return Status::Error(path + ": not a JSON object");
+  }
+  return Status::Ok();
+}
+
+// The page of a `check --out` folder (check.json and frames/checked_F.png).
+Status WriteCheckReport(const std::string& run_dir) {
+  const std::string path = run_dir + "/check.json";
+  json check;
+  STCALIB_RETURN_IF_ERROR(ReadJsonObject(path, &check));
+  const std::string missing =
+      MissingKeys(check, {"stcalib_version", "command", "input", "calibration", "time_offset_s",
+                          "decided", "holds", "reason", "windows", "min_health"});
+  if (!missing.empty()) {
+    return Status::Error(path + ": no " + missing +
+                         " (written by another stcalib version; this one is " + STCALIB_VERSION +
+                         "): run check again");
+  }
+  try {
+    const bool decided = check["decided"].get<bool>(), holds = check["holds"].get<bool>();
+    std::string html = kHead;
+    html += "<h1>stcalib check report</h1>\n<section id=\"verdict\"><h2>Verdict</h2><p class=\"" +
+            std::string(!decided ? "partial"
+                        : holds  ? "whole"
+                                 : "none") +
+            "\"><b>" +
+            (!decided ? "No verdict"
+             : holds  ? "The calibration holds"
+                      : "The calibration is off") +
+            "</b>: " + Escape(check["reason"].get<std::string>()) +
+            "</p><p>Checked: " + Escape(check["calibration"].get<std::string>()) +
+            ", time offset " + Number(1000 * check["time_offset_s"].get<double>(), "%+.1f") +
+            " ms.</p></section>\n";
+    html +=
+        "<section id=\"windows\"><h2>Windows</h2><p>Health: the share of the 728 neighbours "
+        "(±1°, ±5 cm) scoring worse than the calibration (holds at " +
+        Number(check["min_health"].get<double>(), "%.2f") +
+        " or more on average); best neighbour: the largest score gain among them.</p><table>"
+        "<tr><th>frames</th><th>points</th><th>health</th><th>best neighbour</th>"
+        "<th>gray rate</th><th>note</th></tr>";
+    for (const json& w : check["windows"]) {
+      const bool used = w["used"].get<bool>();
+      html += std::string("<tr") + (used ? "" : " class=\"failed\"") + "><td>" +
+              std::to_string(w["first_frame"].get<int>()) + "–" +
+              std::to_string(w["last_frame"].get<int>()) + "</td><td>" +
+              std::to_string(w["points"].get<int>()) + "</td><td>" +
+              Number(w["health"].get<double>(), "%.3f") + "</td><td>" +
+              Number(100 * w["best_neighbour_gain"].get<double>(), "%+.1f %%") + "</td><td>" +
+              Number(w["gray_rate"].get<double>(), "%.3f") + "</td><td>" +
+              Escape(w["note"].get<std::string>()) + "</td></tr>";
+    }
+    html +=
+        "</table></section>\n<section id=\"overlays\"><h2>LiDAR edges on the image</h2>"
+        "<p>At the checked calibration, at the image's full resolution (green: within 2 px of "
+        "an image edge of its direction).</p>";
+    STCALIB_RETURN_IF_ERROR(FrameStrip(run_dir, {"checked_"}, {"checked calibration"}, &html));
+    html += "</section>\n" + RunSection(check) + kTail;
+    return WriteTextFile(run_dir + "/report.html", html);
+  } catch (const json::exception& e) {
+    return Status::Error(path + ": a key has the wrong type (" + e.what() + ")");
+  }
+}
+
 }  // namespace
 
 const char* StcalibVersion() { return STCALIB_VERSION; }
@@ -198,21 +332,16 @@ const char* StcalibVersion() { return STCALIB_VERSION; }
 Status WriteRunReport(const std::string& run_dir) {
   const std::string result_path = run_dir + "/result.json";
   if (!fs::exists(result_path)) {
-    return Status::Error(result_path + ": missing: " + run_dir +
-                         " is not a calibrate run folder (calibrate --out writes result.json)");
+    if (fs::exists(run_dir + "/check.json")) return WriteCheckReport(run_dir);
+    return Status::Error(result_path + ": missing (and no check.json): " + run_dir +
+                         " is no run folder of calibrate --out or check --out");
   }
-  std::string text;
-  STCALIB_RETURN_IF_ERROR(ReadBytes(result_path, &text));
-  const json result = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (result.is_discarded() || !result.is_object()) {
-    return Status::Error(result_path + ": not a JSON object");
-  }
-  std::string missing;
-  for (const char* key : {"stcalib_version", "command", "input", "claim", "held_axes", "reason",
-                          "verdict_rules", "rpy_deg", "T_camera_lidar", "time_offset_s", "std",
-                          "observable", "start", "time_offset_vs_forward"}) {
-    if (!result.contains(key)) missing += std::string(missing.empty() ? "" : ", ") + key;
-  }
+  json result;
+  STCALIB_RETURN_IF_ERROR(ReadJsonObject(result_path, &result));
+  const std::string missing =
+      MissingKeys(result, {"stcalib_version", "command", "input", "claim", "held_axes", "reason",
+                           "verdict_rules", "rpy_deg", "T_camera_lidar", "time_offset_s", "std",
+                           "observable", "start", "time_offset_vs_forward"});
   if (!missing.empty()) {
     return Status::Error(result_path + ": no " + missing +
                          " (written by another stcalib version; this one is " + StcalibVersion() +
@@ -226,18 +355,7 @@ Status WriteRunReport(const std::string& run_dir) {
       return std::find(held.begin(), held.end(), axis) != held.end();
     };
     const std::string claim = result["claim"].get<std::string>();
-    std::string html =
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-        "<title>stcalib report</title><style>"
-        "body{font-family:sans-serif;margin:24px;max-width:1400px}"
-        "table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 8px;"
-        "text-align:left;vertical-align:top}th{background:#eee}"
-        ".whole{color:#060}.partial{color:#a60}.none{color:#b00}.held{color:#a60;font-weight:bold}"
-        ".failed{background:#fdd}.strip{overflow-x:auto}.strip figure{margin:4px 0 12px 0}"
-        ".strip img{display:block}"
-        "svg text{font-size:12px}svg .title{font-weight:bold}svg .zero{stroke:#999}"
-        "svg .band{opacity:0.2}svg polyline{stroke-width:1.5}"
-        "</style></head><body>\n<h1>stcalib calibration report</h1>\n";
+    std::string html = std::string(kHead) + "<h1>stcalib calibration report</h1>\n";
     // The verdict.
     html += "<section id=\"verdict\"><h2>Verdict</h2><p class=\"" + claim + "\"><b>" +
             (claim == "whole"     ? "Claimed"
@@ -302,29 +420,8 @@ Status WriteRunReport(const std::string& run_dir) {
         "<section id=\"overlays\"><h2>LiDAR edges on the image</h2><p>Each frame at the start "
         "and at the estimate, at the image's full resolution (green: within 2 px of an image "
         "edge of its direction).</p>";
-    std::vector<std::string> strip;
-    if (fs::is_directory(run_dir + "/frames")) {
-      for (const auto& entry : fs::directory_iterator(run_dir + "/frames")) {
-        const std::string name = entry.path().filename().string();
-        if (name.rfind("start_", 0) == 0 && entry.path().extension() == ".png") {
-          strip.push_back(name.substr(6, name.size() - 10));
-        }
-      }
-    }
-    std::sort(strip.begin(), strip.end(), [](const std::string& a, const std::string& b) {
-      return std::stoi(a) < std::stoi(b);
-    });
-    for (const std::string& frame : strip) {
-      std::string before, after;
-      STCALIB_RETURN_IF_ERROR(ImageTag(run_dir + "/frames/start_" + frame + ".png",
-                                       "frame " + frame + " at the start", &before));
-      STCALIB_RETURN_IF_ERROR(ImageTag(run_dir + "/frames/estimate_" + frame + ".png",
-                                       "frame " + frame + " at the estimate", &after));
-      html += "<div class=\"strip\"><figure>" + before + "<figcaption>frame " + frame +
-              ", start</figcaption></figure><figure>" + after + "<figcaption>frame " + frame +
-              ", estimate</figcaption></figure></div>";
-    }
-    if (strip.empty()) html += "<p>No frame was used: nothing to draw.</p>";
+    STCALIB_RETURN_IF_ERROR(
+        FrameStrip(run_dir, {"start_", "estimate_"}, {"start", "estimate"}, &html));
     html += "</section>\n";
     // The convergence curves, against the reference, with the refinement's std bands.
     html +=
@@ -388,17 +485,7 @@ Status WriteRunReport(const std::string& run_dir) {
       }
     }
     html += "</p></section>\n";
-    // The run.
-    html += "<section id=\"run\"><h2>Run</h2><table><tr><th>command</th><td><code>" +
-            Escape(result["command"].get<std::string>()) +
-            "</code></td></tr><tr><th>input</th><td>" + Escape(result["input"].get<std::string>()) +
-            "</td></tr><tr><th>version</th><td>" +
-            Escape(result["stcalib_version"].get<std::string>()) + "</td></tr></table></section>\n";
-    // Marks the page once every image decoded (read by the browser test; nothing is fetched).
-    html +=
-        "<script>window.addEventListener('load',function(){var i=document.images,n=0;"
-        "for(var k=0;k<i.length;k++){if(i[k].complete&&i[k].naturalWidth>0)n++;}"
-        "document.body.setAttribute('data-images',n+'/'+i.length);});</script>\n</body></html>\n";
+    html += RunSection(result) + kTail;
     return WriteTextFile(run_dir + "/report.html", html);
   } catch (const json::exception& e) {
     return Status::Error(result_path + ": a key has the wrong type (" + e.what() + ")");

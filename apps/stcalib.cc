@@ -137,8 +137,8 @@ const std::vector<Subcommand>& Subcommands() {
        {"drive", "calib_dir", "bag"}},
       {"report",
        "RUN_DIR",
-       "report.html of a calibrate run folder, written again from its files (result.json, "
-       "per_frame.csv, the pictures)",
+       "report.html of a calibrate or check run folder, written again from the folder's own "
+       "files",
        &RunReport,
        {}},
       {"demo",
