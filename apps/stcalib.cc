@@ -86,8 +86,8 @@ const std::vector<Subcommand>& Subcommands() {
        "[--perturb_trans_m=M] [--perturb_time_s=S] [--init_uncertainty=DEG,M,S] [--seed=S] "
        "[--first_frame=I] [--num_frames=N] [--out=DIR] [--flagfile=configs/X.flags]",
        "online calibration of rotation, translation and time offset; with --out writes the "
-       "estimate, result.json, per_frame.csv and pictures, without it prints the estimate; exit 0 "
-       "only when converged",
+       "estimate, result.json, per_frame.csv, pictures and report.html, without it prints the "
+       "estimate; exit 0 when converged, 3 when converged partly (held axes at the start)",
        &RunCalibrate,
        {"drive",
         "bag",
