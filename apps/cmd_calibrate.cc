@@ -591,32 +591,17 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
         "overlay_after.png",
         DrawEdgeOverlay(image, *last_frame, outcome->estimate, "after: estimate"));
   }
-  // The report's strip: up to kStripFrames frames spread over the refinement's window, each at
-  // the start and at the estimate.
-  constexpr size_t kStripFrames = 4;
-  fs::remove_all(out + "/frames", ec);
-  const std::vector<std::shared_ptr<const CalibrationFrame>> recent = calibrator.RecentFrames();
-  for (size_t k = 0; k < std::min(kStripFrames, recent.size()); ++k) {
-    const size_t pick =
-        recent.size() <= kStripFrames ? k : k * (recent.size() - 1) / (kStripFrames - 1);
-    const CalibrationFrame& frame = *recent[pick];
-    cv::Mat image;
-    status = drive.LoadImage(frame.index, &image);
-    if (!status.ok()) return fail(status);
-    const std::string index = std::to_string(frame.index);
-    pictures.emplace_back(
-        "frames/start_" + index + ".png",
-        DrawEdgeOverlay(image, frame, outcome->initial, "frame " + index + " at the start"));
-    pictures.emplace_back(
-        "frames/estimate_" + index + ".png",
-        DrawEdgeOverlay(image, frame, outcome->estimate, "frame " + index + " at the estimate"));
-  }
-  fs::create_directories(out + "/frames", ec);
   for (const auto& [name, picture] : pictures) {
     status = WriteImage(out + "/" + name, picture);
     if (!status.ok()) return fail(status);
     outcome->pictures.push_back(out + "/" + name);
   }
+  // The report's strip: frames of the refinement's window at the start and at the estimate.
+  status = WriteFrameStrip(drive, calibrator.RecentFrames(),
+                           {{"start_", outcome->initial, "at the start"},
+                            {"estimate_", outcome->estimate, "at the estimate"}},
+                           out, &outcome->pictures);
+  if (!status.ok()) return fail(status);
   status = WriteRunReport(out);
   if (!status.ok()) return fail(status);
   return verdict_code();

@@ -130,23 +130,10 @@ int RunCheck() {
                               {"input", FLAGS_bag.empty() ? FLAGS_drive : FLAGS_bag}};
     status = WriteTextFile(FLAGS_out + "/check.json", j.dump(2) + "\n");
     if (!status.ok()) return ReportError(kCommand, status);
-    // The report's strip: up to 4 frames spread over the checked ones, at the calibration.
-    std::filesystem::remove_all(FLAGS_out + "/frames", ec);
-    std::filesystem::create_directories(FLAGS_out + "/frames", ec);
-    constexpr size_t kStripFrames = 4;
-    for (size_t k = 0; k < std::min(kStripFrames, frames.size()); ++k) {
-      const size_t pick =
-          frames.size() <= kStripFrames ? k : k * (frames.size() - 1) / (kStripFrames - 1);
-      const CalibrationFrame& frame = *frames[pick];
-      cv::Mat image;
-      status = drive.LoadImage(frame.index, &image);
-      if (!status.ok()) return ReportError(kCommand, status);
-      const std::string index = std::to_string(frame.index);
-      status = WriteImage(FLAGS_out + "/frames/checked_" + index + ".png",
-                          DrawEdgeOverlay(image, frame, calibration,
-                                          "frame " + index + " at the checked calibration"));
-      if (!status.ok()) return ReportError(kCommand, status);
-    }
+    // The report's strip: checked frames at the checked calibration.
+    status = WriteFrameStrip(drive, frames,
+                             {{"checked_", calibration, "at the checked calibration"}}, FLAGS_out);
+    if (!status.ok()) return ReportError(kCommand, status);
     status = WriteRunReport(FLAGS_out);
     if (!status.ok()) return ReportError(kCommand, status);
   }

@@ -40,6 +40,19 @@ const std::string& CommandLineText();
 cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
                         const CalibrationState& state, const std::string& title);
 
+// The report's strip (docs/output.md): DIR/frames is made afresh, and up to 4 of `frames`,
+// spread evenly over them, are drawn at every view as frames/<prefix>F.png (F: the frame's
+// index). The paths written go to `written` (optional).
+struct StripView {
+  std::string prefix;  ///< file name before the frame index
+  CalibrationState state;
+  std::string title;  ///< drawn after "frame F "
+};
+Status WriteFrameStrip(const Drive& drive,
+                       const std::vector<std::shared_ptr<const CalibrationFrame>>& frames,
+                       const std::vector<StripView>& views, const std::string& dir,
+                       std::vector<std::string>* written = nullptr);
+
 // Prints "stcalib <command>: error: <message>" to stderr and returns kExitFailure.
 int ReportError(const std::string& command, const Status& status);
 // Prints a usage error and returns kExitUsage.

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -5,6 +6,7 @@
 
 #include "apps/commands.h"
 #include "apps/flags.h"
+#include "core/io/image.h"
 #include "core/io/kitti_calib.h"
 #include "core/io/text.h"
 
@@ -142,6 +144,31 @@ cv::Mat DrawEdgeOverlay(const cv::Mat& image, const CalibrationFrame& frame,
               cv::Point(24, y - 18), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1,
               cv::LINE_AA);
   return canvas;
+}
+
+Status WriteFrameStrip(const Drive& drive,
+                       const std::vector<std::shared_ptr<const CalibrationFrame>>& frames,
+                       const std::vector<StripView>& views, const std::string& dir,
+                       std::vector<std::string>* written) {
+  constexpr size_t kStripFrames = 4;
+  std::error_code ec;
+  std::filesystem::remove_all(dir + "/frames", ec);
+  std::filesystem::create_directories(dir + "/frames", ec);
+  for (size_t k = 0; k < std::min(kStripFrames, frames.size()); ++k) {
+    const size_t pick =
+        frames.size() <= kStripFrames ? k : k * (frames.size() - 1) / (kStripFrames - 1);
+    const CalibrationFrame& frame = *frames[pick];
+    cv::Mat image;
+    STCALIB_RETURN_IF_ERROR(drive.LoadImage(frame.index, &image));
+    const std::string index = std::to_string(frame.index);
+    for (const StripView& view : views) {
+      const std::string path = dir + "/frames/" + view.prefix + index + ".png";
+      STCALIB_RETURN_IF_ERROR(WriteImage(
+          path, DrawEdgeOverlay(image, frame, view.state, "frame " + index + " " + view.title)));
+      if (written != nullptr) written->push_back(path);
+    }
+  }
+  return Status::Ok();
 }
 
 }  // namespace stcalib::cli

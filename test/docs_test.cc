@@ -30,13 +30,9 @@ std::vector<std::string> Lines(const std::string& text) {
 }
 
 int RunShell(const std::string& command, std::string* output) {
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return -1;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) output->append(buffer, n);
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  const testing::CommandResult result = testing::RunCommand(command);
+  *output += result.output;
+  return result.exit_code;
 }
 
 TEST(Docs, ReadmeIsAtMost200Lines) {

@@ -1,5 +1,9 @@
 #include "test/test_util.h"
 
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
 #include <opencv2/core.hpp>
 
 #include "core/io/image.h"
@@ -9,6 +13,20 @@
 #include "core/io/velodyne.h"
 
 namespace stcalib::testing {
+
+CommandResult RunCommand(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return result;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) {
+    result.output.append(buffer.data(), n);
+  }
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return result;
+}
 
 std::string MakeTinyDrive(const std::string& root, int num_frames) {
   namespace fs = std::filesystem;

@@ -31,6 +31,14 @@ inline bool HaveKitti() { return std::filesystem::is_directory(KittiDriveDir());
 // file and the problem. Call after STCALIB_REQUIRE_KITTI(): ASSERT_TRUE(OpenKittiDrive(&drive)).
 ::testing::AssertionResult OpenKittiDrive(Drive* drive, DriveMotion* motion = nullptr);
 
+// A shell command's exit code (128 + signal when killed; -1 when it could not start) and its
+// stdout and stderr together.
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;
+};
+CommandResult RunCommand(const std::string& command);
+
 // A fresh folder under the system temp dir, removed on destruction.
 class ScopedTempDir {
  public:
