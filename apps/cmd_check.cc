@@ -12,7 +12,7 @@
 #include "core/io/kitti_calib.h"
 #include "core/io/text.h"
 #include "core/online/frame_source.h"
-#include "core/online/health_check.h"
+#include "core/online/calibration_check.h"
 
 namespace stcalib::cli {
 
@@ -21,9 +21,7 @@ int RunCheck() {
   if (FLAGS_drive.empty() && FLAGS_bag.empty()) {
     return UsageError(kCommand, "--drive=DRIVE_DIR or --bag=DIR is required");
   }
-  HealthCheckOptions options;
-  options.window_frames = FLAGS_window_frames;
-  options.min_health = FLAGS_min_health;
+  CalibrationCheckOptions options;
   Status status = options.Validate();
   if (!status.ok()) return UsageError(kCommand, status.message());
   Drive drive;
@@ -59,11 +57,8 @@ int RunCheck() {
                                 std::to_string(last) + " out of range (" + std::to_string(count) +
                                 " frames)"));
   }
-  // The texture-suppressed maps: foliage puts an image edge near almost any point, which makes a
-  // plain map's health flat (a calibration 1° off still scores near its neighbours).
   FrameSourceOptions source_options;
-  source_options.suppress_texture = true;
-  source_options.local_map.sweeps = FLAGS_local_map_sweeps;
+  source_options.local_map.sweeps = kCheckLocalMapSweeps;
   status = ImageOptionsFromFlags(&source_options.image);  // the edges calibrate read
   if (!status.ok()) return UsageError(kCommand, status.message());
   source_options.view_T_camera_lidar = calibration.T_camera_lidar;  // the view it checks
@@ -80,35 +75,25 @@ int RunCheck() {
     }
     frames.push_back(frame);
   }
-  const HealthCheckResult result = CheckCalibrationHealth(frames, calibration, options);
+  const CalibrationCheckResult result = CheckCalibration(frames, calibration, options);
 
   std::printf("calibration checked: %s%s; time offset %+.4f s (%s%+.4f s%s)\n", calib_path.c_str(),
               FLAGS_perturb_rot_deg != 0 || FLAGS_perturb_trans_m != 0 ? " (perturbed)" : "",
               calibration.time_offset_s,
               has_time_offset ? (time_offset_path + ": ").c_str() : "none stored: ",
               stored_time_offset_s, FLAGS_perturb_time_s != 0 ? ", plus --perturb_time_s" : "");
-  std::printf(
-      "health = share of the 728 neighbours at +-%.1f deg / +-%.2f m scoring worse; best "
-      "neighbour = the largest score gain among them\n",
-      options.rotation_step_deg, options.translation_step_m);
-  nlohmann::json windows = nlohmann::json::array();
-  for (const WindowHealth& w : result.windows) {
-    if (w.used) {
-      std::printf(
-          "  frames %4d-%-4d %6d points  health %.3f  best neighbour %+5.1f%%  gray rate %.3f\n",
-          w.first_frame, w.last_frame, w.points, w.health, 100 * w.best_neighbour_gain,
-          w.gray_rate);
-    } else {
-      std::printf("  frames %4d-%-4d skipped: %s\n", w.first_frame, w.last_frame, w.note.c_str());
-    }
-    windows.push_back({{"first_frame", w.first_frame},
-                       {"last_frame", w.last_frame},
-                       {"points", w.points},
-                       {"used", w.used},
-                       {"health", w.health},
-                       {"best_neighbour_gain", w.best_neighbour_gain},
-                       {"gray_rate", w.gray_rate},
-                       {"note", w.note}});
+  std::printf("%-16s %10s %10s %10s  %s\n", "axis", "offset", "std", "tolerance", "");
+  nlohmann::json axes = nlohmann::json::array();
+  for (int axis = 0; axis < kNumAxes; ++axis) {
+    const AxisCheck& a = result.axes[axis];
+    std::printf("%-16s %+10.4f %10.4f %10.4f  %s\n", kAxisNames[axis], a.offset, a.std,
+                a.tolerance, a.off ? "off" : a.resolved ? "within" : "not resolved");
+    axes.push_back({{"axis", kAxisNames[axis]},
+                    {"offset", a.offset},
+                    {"std", a.std},
+                    {"tolerance", a.tolerance},
+                    {"resolved", a.resolved},
+                    {"off", a.off}});
   }
   std::printf("%s\n", result.reason.c_str());
   if (!FLAGS_out.empty()) {
@@ -116,15 +101,16 @@ int RunCheck() {
     std::filesystem::create_directories(FLAGS_out, ec);
     const nlohmann::json j = {{"calibration", calib_path},
                               {"time_offset_s", calibration.time_offset_s},
-                              {"decided", result.decided},
-                              {"holds", result.holds},
-                              {"mean_health", result.mean_health},
-                              {"min_window_health", result.min_window_health},
-                              {"min_health", options.min_health},
-                              {"mean_neighbour_gain", result.mean_neighbour_gain},
-                              {"max_neighbour_gain", options.max_neighbour_gain},
+                              {"answer", CheckAnswerName(result.answer)},
                               {"reason", result.reason},
-                              {"windows", windows},
+                              {"frames_used", result.frames_used},
+                              {"blocks", result.blocks},
+                              {"block_frames", result.block_frames},
+                              {"t_quantile", result.t_quantile},
+                              {"rotation_offset_deg", result.rotation_offset_deg},
+                              {"rotation_std_deg", result.rotation_std_deg},
+                              {"tolerance_rotation_deg", options.tolerance_rotation_deg},
+                              {"axes", axes},
                               {"stcalib_version", StcalibVersion()},
                               {"command", CommandLineText()},
                               {"input", FLAGS_bag.empty() ? FLAGS_drive : FLAGS_bag}};
@@ -137,7 +123,15 @@ int RunCheck() {
     status = WriteRunReport(FLAGS_out);
     if (!status.ok()) return ReportError(kCommand, status);
   }
-  return result.decided && result.holds ? kExitOk : kExitFailure;
+  switch (result.answer) {
+    case CheckAnswer::kHolds:
+      return kExitOk;
+    case CheckAnswer::kOff:
+      return kExitCheckOff;
+    case CheckAnswer::kCannotTell:
+      break;
+  }
+  return kExitCannotTell;
 }
 
 }  // namespace stcalib::cli

@@ -19,6 +19,10 @@ constexpr int kExitUsage = 2;    ///< unknown subcommand, missing or invalid fla
 // calibrate: a partial claim. The rotation (and the axes observed) is claimed and written; the
 // axes the drive does not constrain keep their start values, marked held.
 constexpr int kExitPartial = 3;
+// check: the calibration is off (some axis lies beyond its tolerance of the drive's optimum).
+constexpr int kExitCheckOff = 4;
+// check: the drive cannot tell (it does not resolve the rotation to within the tolerance).
+constexpr int kExitCannotTell = 5;
 
 int RunInfo();
 int RunProject();

@@ -272,46 +272,56 @@ Status WriteCheckReport(const std::string& run_dir) {
   const std::string path = run_dir + "/check.json";
   json check;
   STCALIB_RETURN_IF_ERROR(ReadJsonObject(path, &check));
-  const std::string missing =
-      MissingKeys(check, {"stcalib_version", "command", "input", "calibration", "time_offset_s",
-                          "decided", "holds", "reason", "windows", "min_health"});
+  const std::string missing = MissingKeys(
+      check, {"stcalib_version", "command", "input", "calibration", "time_offset_s", "answer",
+              "reason", "frames_used", "blocks", "block_frames", "t_quantile", "axes",
+              "rotation_offset_deg", "rotation_std_deg", "tolerance_rotation_deg"});
   if (!missing.empty()) {
     return Status::Error(path + ": no " + missing +
                          " (written by another stcalib version; this one is " + STCALIB_VERSION +
                          "): run check again");
   }
   try {
-    const bool decided = check["decided"].get<bool>(), holds = check["holds"].get<bool>();
+    const std::string answer = check["answer"].get<std::string>();
     std::string html = kHead;
     html += "<h1>stcalib check report</h1>\n<section id=\"verdict\"><h2>Verdict</h2><p class=\"" +
-            std::string(!decided ? "partial"
-                        : holds  ? "whole"
-                                 : "none") +
+            std::string(answer == "holds" ? "whole"
+                        : answer == "off" ? "none"
+                                          : "partial") +
             "\"><b>" +
-            (!decided ? "No verdict"
-             : holds  ? "The calibration holds"
-                      : "The calibration is off") +
+            (answer == "holds" ? "The calibration holds"
+             : answer == "off" ? "The calibration is off"
+                               : "This drive cannot tell") +
             "</b>: " + Escape(check["reason"].get<std::string>()) +
             "</p><p>Checked: " + Escape(check["calibration"].get<std::string>()) +
             ", time offset " + Number(1000 * check["time_offset_s"].get<double>(), "%+.1f") +
             " ms.</p></section>\n";
-    html +=
-        "<section id=\"windows\"><h2>Windows</h2><p>Health: the share of the 728 neighbours "
-        "(±1°, ±5 cm) scoring worse than the calibration (holds at " +
-        Number(check["min_health"].get<double>(), "%.2f") +
-        " or more on average); best neighbour: the largest score gain among them.</p><table>"
-        "<tr><th>frames</th><th>points</th><th>health</th><th>best neighbour</th>"
-        "<th>gray rate</th><th>note</th></tr>";
-    for (const json& w : check["windows"]) {
-      const bool used = w["used"].get<bool>();
-      html += std::string("<tr") + (used ? "" : " class=\"failed\"") + "><td>" +
-              std::to_string(w["first_frame"].get<int>()) + "–" +
-              std::to_string(w["last_frame"].get<int>()) + "</td><td>" +
-              std::to_string(w["points"].get<int>()) + "</td><td>" +
-              Number(w["health"].get<double>(), "%.3f") + "</td><td>" +
-              Number(100 * w["best_neighbour_gain"].get<double>(), "%+.1f %%") + "</td><td>" +
-              Number(w["gray_rate"].get<double>(), "%.3f") + "</td><td>" +
-              Escape(w["note"].get<std::string>()) + "</td></tr>";
+    const double t = check["t_quantile"].get<double>();
+    html += "<section id=\"axes\"><h2>Per axis</h2><p>Offset: the drive's optimum near the "
+            "checked calibration minus the calibration; std: its spread over the drive (the "
+            "larger of a delete-a-block jackknife over " +
+            std::to_string(check["blocks"].get<int>()) + " blocks of " +
+            std::to_string(check["block_frames"].get<int>()) + " frames and the refinement's "
+            "covariance); t = " + Number(t, "%.2f") +
+            ", the one-sided 99 % quantile of Student's t over the blocks. The rotation lies " +
+            Number(check["rotation_offset_deg"].get<double>(), "%.2f") + "° from the optimum (std " +
+            Number(check["rotation_std_deg"].get<double>(), "%.2f") + "° along it; tolerance " +
+            Number(check["tolerance_rotation_deg"].get<double>(), "%.2f") +
+            "°): off beyond tolerance + t·std. An axis is resolved when t·std ≤ tolerance, and a "
+            "resolved translation axis or δ off beyond tolerance + t·std.</p><table><tr><th>axis</th><th>offset</th><th>std</th>"
+            "<th>tolerance</th><th>answer</th></tr>";
+    for (const json& a : check["axes"]) {
+      const std::string name = a["axis"].get<std::string>();
+      const bool off = a["off"].get<bool>(), resolved = a["resolved"].get<bool>();
+      const bool degrees = name.find("_deg") != std::string::npos;
+      const bool metres = name.find("_m") != std::string::npos && !degrees;
+      const double scale = degrees ? 1 : metres ? 100 : 1000;
+      const char* unit = degrees ? " °" : metres ? " cm" : " ms";
+      html += std::string("<tr") + (off ? " class=\"failed\"" : "") + "><td>" + Escape(name) +
+              "</td><td>" + Number(scale * a["offset"].get<double>(), "%+.2f") + unit +
+              "</td><td>" + Number(scale * a["std"].get<double>(), "%.2f") + unit + "</td><td>" +
+              Number(scale * a["tolerance"].get<double>(), "%.2f") + unit + "</td><td>" +
+              (off ? "off" : resolved ? "within" : "not resolved") + "</td></tr>";
     }
     html +=
         "</table></section>\n<section id=\"overlays\"><h2>LiDAR edges on the image</h2>"

@@ -120,15 +120,14 @@ const std::vector<Subcommand>& Subcommands() {
        "[--init_calib=FILE] [--perturb_rot_deg=D] "
        "[--perturb_trans_m=M] [--perturb_time_s=S (added to the stored δ)] [--seed=S] "
        "[--first_frame=I] "
-       "[--num_frames=N] [--out=DIR] "
-       "[--min_health=H]",
-       "health score of the stored calibration (δ from time_offset.txt beside it) per window of "
-       "frames; exit 0 when it holds, 1 "
-       "when it is off, with the evidence",
+       "[--num_frames=N] [--out=DIR]",
+       "tests the stored calibration (δ from time_offset.txt beside it) against the drive's own "
+       "optimum and its spread: exit 0 when it holds, 4 when it is off, 5 when the drive cannot "
+       "tell, with the per-axis evidence",
        &RunCheck,
        {"drive", "calib_dir", "bag", "image_topic", "cloud_topic", "odom_topic", "init_calib",
         "perturb_rot_deg", "perturb_trans_m", "perturb_time_s", "seed", "first_frame", "num_frames",
-        "out", "min_health"}},
+        "out"}},
       {"convert",
        "--drive=DRIVE_DIR [--calib_dir=DIR] --bag=OUT_DIR",
        "a drive written as a ROS 2 bag (MCAP): image, camera info, cloud with rings and point "

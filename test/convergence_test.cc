@@ -86,7 +86,7 @@ TEST(Convergence, ReportedStdCountsEachSweepOnce) {
   EXPECT_NEAR(four.std_dev[5], std::sqrt(0.02 * 0.02 + 0.02 * 0.02), 1e-12);
   EXPECT_NEAR(four.std_dev[6], 0.005, 1e-12);
   verdict.rotation_jackknife.frames = 12;
-  verdict.rotation_jackknife.std_deg = Eigen::Vector3d(0.5, 0.0, 0.0);
+  verdict.rotation_jackknife.std[0] = 0.5;
   const ReportedUncertainty floored = ReportUncertainty(verdict, true, 0.04);
   EXPECT_DOUBLE_EQ(floored.std_dev[0], 0.5);
   EXPECT_DOUBLE_EQ(floored.std_dev[1], four.std_dev[1]);
@@ -368,18 +368,18 @@ TEST(Convergence, RotationJackknifeOverBlocksOfFrames) {
   RefineOptions options;
   options.loss = RefineOptions::Loss::kTukey;
   options.loss_scale_px = 5.0;
-  const RotationJackknife spread = JackknifeRotation(frames, kitti, kitti, options, 3);
+  const RefineJackknife spread = JackknifeRotation(frames, kitti, kitti, options, 3);
   EXPECT_EQ(spread.frames, 9);
   EXPECT_EQ(spread.blocks, 3);
   EXPECT_EQ(spread.failed, 0);
   for (int axis = 0; axis < 3; ++axis) {
-    EXPECT_GT(spread.std_deg[axis], 1e-4) << axis;
-    EXPECT_LT(spread.std_deg[axis], 0.5) << axis;
+    EXPECT_GT(spread.std[axis], 1e-4) << axis;
+    EXPECT_LT(spread.std[axis], 0.5) << axis;
   }
   const std::vector<const CalibrationFrame*> same(6, frames[4]);
-  const RotationJackknife none = JackknifeRotation(same, kitti, kitti, options, 3);
+  const RefineJackknife none = JackknifeRotation(same, kitti, kitti, options, 3);
   EXPECT_EQ(none.blocks, 2);
-  EXPECT_LT(none.std_deg.norm(), 1e-6);
+  EXPECT_LT(none.std.head<3>().norm(), 1e-6);
   EXPECT_EQ(JackknifeRotation({frames[0], frames[1], frames[2]}, kitti, kitti, options, 3).frames,
             0);
 }

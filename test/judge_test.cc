@@ -36,10 +36,10 @@ ConvergenceEvidence Passing() {
   e.prior_sigma_translation_m = 0.05;
   e.final_health = 0.97;
   e.settle_deg = 0.05;
-  RotationJackknife jackknife;
+  RefineJackknife jackknife;
   jackknife.frames = 10;
   jackknife.blocks = 3;
-  jackknife.std_deg = Eigen::Vector3d(0.08, 0.05, 0.02);
+  jackknife.std.head<3>() = Eigen::Vector3d(0.08, 0.05, 0.02);
   e.rotation_jackknife = jackknife;
   HealthCheckResult check;
   check.decided = check.holds = true;
@@ -150,9 +150,9 @@ TEST(Judge, EachRuleRefusesItsOwnFailure) {
   EXPECT_EQ(FirstFailure(e), "settled");
 
   e = Passing();
-  e.rotation_jackknife->std_deg.x() = 0.19;  // under 0.2°: a claim
+  e.rotation_jackknife->std.x() = 0.19;  // under 0.2°: a claim
   EXPECT_EQ(FirstFailure(e), "");
-  e.rotation_jackknife->std_deg.x() = 0.2;  // roll: leaving blocks out moves it 0.2°
+  e.rotation_jackknife->std.x() = 0.2;  // roll: leaving blocks out moves it 0.2°
   EXPECT_EQ(FirstFailure(e), kJackknifeRule);
   EXPECT_NE(Judge(e, {}).reason.find("roll_deg is not pinned down"), std::string::npos);
   e.rotation_jackknife->frames = 0;  // too few frames to leave a block out: nothing to judge
@@ -305,16 +305,16 @@ TEST(Judge, AStillAcquiringRunNamesItsRunnersUp) {
 
 // The jackknife's std: sqrt((n − 1) / n · Σ (θ_i − θ̄)²) per component.
 TEST(Jackknife, StdOfLeaveOneOutEstimates) {
-  EXPECT_EQ(JackknifeStd({}), Eigen::Vector3d::Zero());
-  EXPECT_EQ(JackknifeStd({Eigen::Vector3d(1, 2, 3)}), Eigen::Vector3d::Zero());
+  EXPECT_EQ(JackknifeStd<3>({}), Eigen::Vector3d::Zero());
+  EXPECT_EQ(JackknifeStd<3>({Eigen::Vector3d(1, 2, 3)}), Eigen::Vector3d::Zero());
   // Two estimates ±a about their mean: sqrt(1/2 · 2a²) = a.
   const Eigen::Vector3d s =
-      JackknifeStd({Eigen::Vector3d(0.1, 0, -1), Eigen::Vector3d(-0.1, 0, 1)});
+      JackknifeStd<3>({Eigen::Vector3d(0.1, 0, -1), Eigen::Vector3d(-0.1, 0, 1)});
   EXPECT_NEAR(s.x(), 0.1, 1e-12);
   EXPECT_NEAR(s.y(), 0.0, 1e-12);
   EXPECT_NEAR(s.z(), 1.0, 1e-12);
   // Four estimates 0, 0, 0, 4 (mean 1): sqrt(3/4 · (1 + 1 + 1 + 9)) = 3.
-  const Eigen::Vector3d four = JackknifeStd({Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+  const Eigen::Vector3d four = JackknifeStd<3>({Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                                              Eigen::Vector3d::Zero(), Eigen::Vector3d(4, 0, 0)});
   EXPECT_NEAR(four.x(), 3.0, 1e-12);
 }

@@ -95,7 +95,7 @@ TEST(Report, SharedFramesRunOpensInABrowser) {
               HasSubstr(result["stcalib_version"].get<std::string>()));
 }
 
-// check --out writes its own page: the verdict, the windows and the frames at the checked
+// check --out writes its own page: the answer, the per-axis table and the frames at the checked
 // calibration.
 TEST(Report, CheckRunOpensInABrowser) {
   STCALIB_REQUIRE_KITTI();
@@ -105,7 +105,7 @@ TEST(Report, CheckRunOpensInABrowser) {
   const RunResult r =
       Stcalib("check --drive=" + testing::KittiDriveDir() + " --num_frames=9 --out=" + out);
   ASSERT_NE(r.exit_code, 2) << r.output;
-  CheckReportInBrowser(out, {"verdict", "windows", "overlays", "run"}, 4);
+  CheckReportInBrowser(out, {"verdict", "axes", "overlays", "run"}, 4);
   EXPECT_THAT(testing::ReadFile(out + "/report.html"), HasSubstr("calib_velo_to_cam.txt"));
 }
 

@@ -239,15 +239,15 @@ constexpr double kMaxJackknifeStdDeg = 0.2;
 
 RuleOutcome Jackknife(const ConvergenceEvidence& e, const ConvergenceOptions&) {
   if (!e.rotation_jackknife) return {kJackknifeRule, false, "the jackknife was not measured"};
-  const RotationJackknife& j = *e.rotation_jackknife;
+  const RefineJackknife& j = *e.rotation_jackknife;
   if (j.frames == 0) return {kJackknifeRule, true, "too few frames to leave a block out"};
   const std::string spread =
       Format("the rotation's jackknife std over %.0f frames in %.0f blocks is ", j.frames,
              j.blocks) +
-      Format("%.3f / %.3f / %.3f deg (roll / pitch / yaw)", j.std_deg.x(), j.std_deg.y(),
-             j.std_deg.z());
+      Format("%.3f / %.3f / %.3f deg (roll / pitch / yaw)", j.std.x(), j.std.y(),
+             j.std.z());
   for (int axis = 0; axis < 3; ++axis) {
-    if (!(j.std_deg[axis] < kMaxJackknifeStdDeg)) {
+    if (!(j.std[axis] < kMaxJackknifeStdDeg)) {
       return {kJackknifeRule, false,
               std::string(kAxisNames[axis]) + " is not pinned down by these frames: " + spread +
                   Format(", over %.2f deg: leaving out a few frames moves the estimate",
@@ -513,7 +513,7 @@ ReportedUncertainty ReportUncertainty(const ConvergenceVerdict& verdict, bool ti
   if (verdict.rotation_jackknife.frames > 0) {
     for (int k = 0; k < 3; ++k) {
       if (!reported.has_std[k]) continue;
-      reported.std_dev[k] = std::max(reported.std_dev[k], verdict.rotation_jackknife.std_deg[k]);
+      reported.std_dev[k] = std::max(reported.std_dev[k], verdict.rotation_jackknife.std[k]);
     }
   }
   // A translation axis: at least the window refinements' spread about the estimate, and not

@@ -93,7 +93,7 @@ struct ConvergenceEvidence {
   // The rotation's block jackknife over the refinement's frames (JackknifeRotation, blocks of the
   // frames that share sweeps): measured only once every rule before it passes (a refinement per
   // block); its std must stay under 0.2° on every axis.
-  std::optional<RotationJackknife> rotation_jackknife;
+  std::optional<RefineJackknife> rotation_jackknife;
   // The check on texture-suppressed maps: measured only once every other rule passes (it costs
   // a health score per window), over `suppressed_check_frames` frames.
   std::optional<HealthCheckResult> suppressed_check;
@@ -174,7 +174,7 @@ struct ConvergenceVerdict {
   int refinement_spread_updates = 0;
   // The rotation's jackknife over the refinement's frames (when measured: frames > 0); the
   // reported rotation std is at least its std.
-  RotationJackknife rotation_jackknife;
+  RefineJackknife rotation_jackknife;
   // Frames each sweep's points appear in (1 + the oldest sweep age of the window's local maps):
   // the reported covariance stds are √ of it larger than the refinement's (ReportUncertainty).
   int shared_sweep_frames = 1;

@@ -1,36 +1,20 @@
 #include "core/refine/jackknife.h"
 
-#include <cmath>
-
-#include "core/types/calibration.h"
-#include "core/types/transform.h"
+#include <algorithm>
 
 namespace stcalib {
 
-Eigen::Vector3d JackknifeStd(const std::vector<Eigen::Vector3d>& leave_one_out) {
-  const size_t n = leave_one_out.size();
-  if (n < 2) return Eigen::Vector3d::Zero();
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& v : leave_one_out) mean += v;
-  mean /= static_cast<double>(n);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& v : leave_one_out) sum += (v - mean).cwiseAbs2();
-  return (sum * (static_cast<double>(n - 1) / static_cast<double>(n))).cwiseSqrt();
-}
-
-RotationJackknife JackknifeRotation(const std::vector<const CalibrationFrame*>& frames,
-                                    const CalibrationState& estimate,
-                                    const CalibrationState& mount_prior, RefineOptions options,
-                                    int block_frames, int min_frames) {
-  RotationJackknife result;
+RefineJackknife JackknifeRefine(const std::vector<const CalibrationFrame*>& frames,
+                                const CalibrationState& estimate,
+                                const CalibrationState& mount_prior, const RefineOptions& options,
+                                int block_frames, int min_frames) {
+  RefineJackknife result;
   const int n = static_cast<int>(frames.size());
   const int blocks = n / std::max(block_frames, 1);
   if (n < min_frames || blocks < 2) return result;
   result.frames = n;
   result.blocks = blocks;
-  options.translation = RefineOptions::Translation::kHeld;
-  options.estimate_time_offset = false;
-  std::vector<Eigen::Vector3d> rotations;
+  std::vector<Eigen::Matrix<double, kNumAxes, 1>> estimates;
   for (int out = 0; out < blocks; ++out) {
     // Block `out` is frames [n·out/blocks, n·(out+1)/blocks): contiguous, as even as n allows.
     const int first = n * out / blocks, end = n * (out + 1) / blocks;
@@ -43,11 +27,19 @@ RotationJackknife JackknifeRotation(const std::vector<const CalibrationFrame*>& 
       ++result.failed;
       continue;
     }
-    rotations.push_back(LogSO3(estimate.T_camera_lidar.linear().transpose() *
-                               refined.state.T_camera_lidar.linear()));
+    estimates.push_back(AxisOffsets(refined.state, estimate));
   }
-  result.std_deg = JackknifeStd(rotations) * (180.0 / M_PI);
+  result.std = JackknifeStd<kNumAxes>(estimates);
   return result;
+}
+
+RefineJackknife JackknifeRotation(const std::vector<const CalibrationFrame*>& frames,
+                                  const CalibrationState& estimate,
+                                  const CalibrationState& mount_prior, RefineOptions options,
+                                  int block_frames, int min_frames) {
+  options.translation = RefineOptions::Translation::kHeld;
+  options.estimate_time_offset = false;
+  return JackknifeRefine(frames, estimate, mount_prior, options, block_frames, min_frames);
 }
 
 }  // namespace stcalib

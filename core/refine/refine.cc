@@ -46,6 +46,15 @@ Status RefineOptions::Validate() const {
   return Status::Ok();
 }
 
+Eigen::Matrix<double, kNumAxes, 1> AxisOffsets(const CalibrationState& state,
+                                               const CalibrationState& reference) {
+  const CalibrationError error = ComputeCalibrationError(state, reference);
+  Eigen::Matrix<double, kNumAxes, 1> offsets;
+  offsets << error.roll_deg, error.pitch_deg, error.yaw_deg, error.translation_m,
+      error.time_offset_s;
+  return offsets;
+}
+
 RefineResult Refine(const std::vector<const CalibrationFrame*>& window,
                     const CalibrationState& start, const CalibrationState& rotation_prior,
                     const CalibrationState& mount_prior, const RefineOptions& options) {

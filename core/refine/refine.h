@@ -65,6 +65,11 @@ std::string LossChoices();
 constexpr int kNumAxes = 7;
 extern const std::array<const char*, kNumAxes> kAxisNames;  // roll_deg, ..., time_offset_s
 
+// The offsets of `state` from `reference` per axis, in result order and units: the rotation of
+// R_refᵀ·R (about the LiDAR axes) [deg], the translation [m], δ [s] (ComputeCalibrationError).
+Eigen::Matrix<double, kNumAxes, 1> AxisOffsets(const CalibrationState& state,
+                                               const CalibrationState& reference);
+
 struct RefineResult {
   CalibrationState state;
   bool usable = false;
