@@ -615,12 +615,8 @@ std::string CalibrateFlagsError() {
   StartUncertainty uncertainty;
   const Status uncertainty_status = ParseStartUncertainty(FLAGS_init_uncertainty, &uncertainty);
   if (!uncertainty_status.ok()) return uncertainty_status.message();
-  const size_t hypotheses = HypothesisLattice::CountFor(uncertainty, LatticeSteps());
-  if (hypotheses > HypothesisLattice::kMaxHypotheses) {
-    return "--init_uncertainty=" + FLAGS_init_uncertainty + ": a lattice of " +
-           std::to_string(hypotheses) + " hypotheses does not fit in memory (at most " +
-           std::to_string(HypothesisLattice::kMaxHypotheses) + "): narrow the start uncertainty";
-  }
+  const Status fits = HypothesisLattice::CheckFits(uncertainty, LatticeSteps());
+  if (!fits.ok()) return "--init_uncertainty=" + FLAGS_init_uncertainty + ": " + fits.message();
   OnlineCalibratorOptions::Folds folds;
   if (!ParseFolds(FLAGS_lidar_folds, &folds)) {
     return "--lidar_folds must be " + FoldsChoices();

@@ -66,25 +66,14 @@ void BM_ImageFeatures(benchmark::State& state) {
 }
 BENCHMARK(BM_ImageFeatures)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
-void BM_ImageFeaturesWithPyramid(benchmark::State& state) {
-  REQUIRE_KITTI(state);
-  ImageFeatureOptions options;
-  options.pyramid_basins_px = {60, 30};
-  for (auto _ : state) benchmark::DoNotOptimize(ExtractImageFeatures(Kitti().image, options));
-}
-BENCHMARK(BM_ImageFeaturesWithPyramid)->Unit(benchmark::kMillisecond);
-
 // As the online frame source asks for them (FrameSourceOptions::ImageOptions: the oriented maps
-// only). Arg 0: with the texture-suppressed pyramid, which a calibrator without the rotation grid
-// reads; arg 1: without it, as `stcalib calibrate` runs with the defaults.
+// only), as `stcalib calibrate` runs with the defaults.
 void BM_ImageFeaturesAsOnline(benchmark::State& state) {
   REQUIRE_KITTI(state);
-  ImageFeatureOptions options = FrameSourceOptions().ImageOptions();
-  if (state.range(0) == 1) options.pyramid_basins_px.clear();
+  const ImageFeatureOptions options = FrameSourceOptions().ImageOptions();
   for (auto _ : state) benchmark::DoNotOptimize(ExtractImageFeatures(Kitti().image, options));
-  state.SetLabel(state.range(0) == 1 ? "as calibrate runs (no pyramid)" : "with the pyramid");
 }
-BENCHMARK(BM_ImageFeaturesAsOnline)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ImageFeaturesAsOnline)->Unit(benchmark::kMillisecond);
 
 // The rows LiDAR points can reach (below the top beam at +2°, with margin), as the online path
 // uses them: rows 110..374 of the 375.

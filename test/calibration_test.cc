@@ -518,8 +518,19 @@ TEST(Calibration, StagesAgainstSimulatedTruth) {
       EXPECT_LE(nearest, 0.5 + 1e-9) << v.transpose();
     }
     HypothesisLattice too_large;
-    EXPECT_FALSE(
-        HypothesisLattice::Create(lattice_start, wide, LatticeSteps(), &too_large, 1000).ok());
+    const Status refused =
+        HypothesisLattice::Create(lattice_start, wide, LatticeSteps(), &too_large, 1000);
+    EXPECT_FALSE(refused.ok());
+    EXPECT_EQ(refused.message(), "a lattice of " + std::to_string(lattice.size()) +
+                                     " hypotheses does not fit in memory (at most 1000): narrow "
+                                     "the start uncertainty");
+    // The calibrator's options refuse what the lattice refuses, with the same words.
+    OnlineCalibratorOptions online;
+    online.start_uncertainty = {60, 2, 1};
+    const Status huge = online.Validate();
+    EXPECT_FALSE(huge.ok());
+    EXPECT_NE(huge.message().find("does not fit in memory (at most 4000000)"), std::string::npos)
+        << huge.message();
     const CalibrationFrame& frame = *window[0];
     ASSERT_FALSE(frame.coarse_map[0].empty());
     std::vector<float> scores;

@@ -153,46 +153,18 @@ TEST(ImageFeatures, RegionOfInterestMatchesTheFullImageInside) {
 
 TEST(ImageFeatures, BlackImageGivesEmptyFeaturesNotACrash) {
   ImageFeatureOptions options;
-  options.pyramid_basins_px = {40, 20};
   const ImageFeatures f = ExtractImageFeatures(cv::Mat::zeros(50, 80, CV_8UC3), options);
   EXPECT_TRUE(f.empty());
   EXPECT_EQ(cv::countNonZero(f.idt), 0);
-  EXPECT_EQ(f.idt_pyramid.size(), 2u);
   EXPECT_TRUE(ExtractImageFeatures(cv::Mat(), options).empty());
-  // Split by orientation: the oriented maps exist and are flat, with their pyramid levels.
+  // Split by orientation: the oriented maps exist and are flat.
   options.split_orientation = true;
   const ImageFeatures split = ExtractImageFeatures(cv::Mat::zeros(50, 80, CV_8UC3), options);
-  EXPECT_TRUE(split.idt_pyramid.empty());
   for (const OrientedMaps& m : split.oriented) {
-    ASSERT_EQ(m.pyramid.size(), 2u);
     EXPECT_EQ(m.idt.size(), cv::Size(80, 50));
     EXPECT_EQ(cv::countNonZero(m.idt_bandpass), 0);
-    EXPECT_EQ(cv::countNonZero(m.pyramid[1]), 0);
+    EXPECT_EQ(cv::countNonZero(m.idt_suppressed), 0);
     EXPECT_EQ(cv::countNonZero(m.distance_px != options.basin_px), 0);
-  }
-}
-
-// With split orientation the pyramid levels are the oriented maps' own (an unsplit pyramid would
-// be read by nothing): each level is the IDT of that orientation's distances at the level's
-// basin, texture-suppressed.
-TEST(ImageFeatures, SplitOrientationBuildsThePyramidOnTheOrientedMapsOnly) {
-  cv::Mat image(120, 200, CV_8UC3, cv::Scalar::all(60));
-  cv::rectangle(image, cv::Rect(50, 30, 60, 50), cv::Scalar::all(200), cv::FILLED);
-  ImageFeatureOptions options;
-  options.split_orientation = true;
-  options.pyramid_basins_px = {40, 20};
-  const ImageFeatures f = ExtractImageFeatures(image, options);
-  ASSERT_FALSE(f.empty());
-  EXPECT_TRUE(f.idt_pyramid.empty());
-  const cv::Mat* raw[2] = {&f.distance_vertical_raw_px, &f.distance_horizontal_raw_px};
-  for (int o = 0; o < 2; ++o) {
-    ASSERT_EQ(f.oriented[o].pyramid.size(), 2u);
-    for (size_t i = 0; i < 2; ++i) {
-      const double basin = options.pyramid_basins_px[i];
-      const cv::Mat expected = SuppressTexture(InverseDistanceTransform(*raw[o], basin, basin / 10),
-                                               std::max(12.0, 2 * basin));
-      EXPECT_EQ(cv::norm(f.oriented[o].pyramid[i], expected, cv::NORM_INF), 0.0) << o << " " << i;
-    }
   }
 }
 
@@ -204,7 +176,6 @@ TEST(ImageFeatures, OrientedMapsAloneEqualThoseBesideTheUnsplitOnes) {
   cv::line(image, cv::Point(120, 100), cv::Point(190, 20), cv::Scalar::all(220), 2);
   ImageFeatureOptions options;
   options.split_orientation = true;
-  options.pyramid_basins_px = {40};
   const ImageFeatures both = ExtractImageFeatures(image, options);
   options.unsplit_maps = false;
   const ImageFeatures alone = ExtractImageFeatures(image, options);
@@ -224,8 +195,6 @@ TEST(ImageFeatures, OrientedMapsAloneEqualThoseBesideTheUnsplitOnes) {
     EXPECT_EQ(cv::norm(a.idt_bandpass, b.idt_bandpass, cv::NORM_INF), 0);
     EXPECT_EQ(cv::norm(a.idt_suppressed, b.idt_suppressed, cv::NORM_INF), 0);
     EXPECT_EQ(cv::norm(a.distance_px, b.distance_px, cv::NORM_INF), 0);
-    ASSERT_EQ(a.pyramid.size(), 1u);
-    EXPECT_EQ(cv::norm(a.pyramid[0], b.pyramid[0], cv::NORM_INF), 0);
   }
 }
 
@@ -271,11 +240,9 @@ TEST(ImageFeatures, LineDetectorsFindSegmentsOnKitti) {
        {ImageFeatureOptions::Detector::kLsd, ImageFeatureOptions::Detector::kFastLine}) {
     ImageFeatureOptions options;
     options.detector = detector;
-    options.pyramid_basins_px = {60, 30};
     const ImageFeatures f = ExtractImageFeatures(image, options);
     EXPECT_GT(f.segments.size(), 200u);
     EXPECT_GT(f.edge_pixels, 5000);
-    ASSERT_EQ(f.idt_pyramid.size(), 2u);
     for (const cv::Vec4f& s : f.segments) {  // full-size coordinates
       EXPECT_LE(std::max(s[0], s[2]), image.cols);
       EXPECT_LE(std::max(s[1], s[3]), image.rows);

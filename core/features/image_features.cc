@@ -63,12 +63,6 @@ void CappedDistanceAndIdt(const cv::Mat& distance_raw_px, const ImageFeatureOpti
   distance_px->convertTo(*idt, CV_32F, -255.0 / options.basin_px, 255.0);
 }
 
-// With split orientation the oriented maps carry their own pyramids; an unsplit one would be two
-// wide blurs per level that nothing reads.
-size_t UnsplitPyramidLevels(const ImageFeatureOptions& options) {
-  return options.split_orientation ? 0 : options.pyramid_basins_px.size();
-}
-
 }  // namespace
 
 namespace {
@@ -101,9 +95,6 @@ Status ImageFeatureOptions::Validate() const {
   }
   if (canny_low < 0 || canny_high < canny_low) {
     return Status::Error("image features: need 0 <= canny_low <= canny_high");
-  }
-  for (double b : pyramid_basins_px) {
-    if (!(b > 0)) return Status::Error("image features: pyramid basins must be > 0");
   }
   return Status::Ok();
 }
@@ -237,10 +228,6 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     features.idt = embed(crop.idt, CV_32F, 0);
     features.idt_suppressed = embed(crop.idt_suppressed, CV_32F, 0);
     features.idt_bandpass = embed(crop.idt_bandpass, CV_32F, 0);
-    for (size_t i = 0; i < UnsplitPyramidLevels(options); ++i) {
-      features.idt_pyramid.push_back(
-          embed(i < crop.idt_pyramid.size() ? crop.idt_pyramid[i] : cv::Mat(), CV_32F, 0));
-    }
     features.segments = crop.segments;
     for (cv::Vec4f& s : features.segments) s += cv::Vec4f(roi.x, roi.y, roi.x, roi.y);
     features.edge_pixels = crop.edge_pixels;
@@ -281,18 +268,12 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     features.idt = cv::Mat::zeros(gray.size(), CV_32F);
     features.idt_suppressed = features.idt.clone();
     features.idt_bandpass = features.idt.clone();
-    for (size_t i = 0; i < UnsplitPyramidLevels(options); ++i) {
-      features.idt_pyramid.push_back(features.idt.clone());
-    }
     if (options.split_orientation) {  // the same maps as with edges, all flat
       for (OrientedMaps& m : features.oriented) {
         m.idt = features.idt.clone();
         m.idt_suppressed = features.idt.clone();
         m.idt_bandpass = features.idt.clone();
         m.distance_px = features.distance_px.clone();
-        for (size_t i = 0; i < options.pyramid_basins_px.size(); ++i) {
-          m.pyramid.push_back(features.idt.clone());
-        }
       }
     }
     return features;
@@ -340,15 +321,6 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
     features.idt_bandpass = BandPass(features.idt, options.suppression_sigma_px);
     cv::max(features.idt_bandpass, 0.0, features.idt_suppressed);
   }
-  for (size_t i = 0; i < UnsplitPyramidLevels(options); ++i) {
-    const double basin = options.pyramid_basins_px[i];
-    cv::Mat level =
-        InverseDistanceTransform(distance, basin, std::max(options.smoothing_sigma_px, basin / 10));
-    if (options.suppress_pyramid) {
-      level = SuppressTexture(level, std::max(options.suppression_sigma_px, 2 * basin));
-    }
-    features.idt_pyramid.push_back(level);
-  }
   if (options.split_orientation) {
     const cv::Mat* raw[2] = {&features.distance_vertical_raw_px,
                              &features.distance_horizontal_raw_px};
@@ -357,14 +329,6 @@ ImageFeatures ExtractImageFeatures(const cv::Mat& image, const ImageFeatureOptio
       CappedDistanceAndIdt(*raw[o], options, &m.distance_px, &m.idt);
       m.idt_bandpass = BandPass(m.idt, options.suppression_sigma_px);
       cv::max(m.idt_bandpass, 0.0, m.idt_suppressed);
-      for (double basin : options.pyramid_basins_px) {
-        cv::Mat level = InverseDistanceTransform(*raw[o], basin,
-                                                 std::max(options.smoothing_sigma_px, basin / 10));
-        if (options.suppress_pyramid) {
-          level = SuppressTexture(level, std::max(options.suppression_sigma_px, 2 * basin));
-        }
-        m.pyramid.push_back(level);
-      }
     }
   }
   return features;

@@ -28,8 +28,6 @@ struct ImageFeatureOptions {
   double basin_px = 20;               ///< D_max of the IDT [px]
   double smoothing_sigma_px = 1.5;    ///< Gaussian σ applied to the IDT and distance maps [px]
   double suppression_sigma_px = 12;   ///< wide blur subtracted for the texture-suppressed map [px]
-  std::vector<double> pyramid_basins_px;  ///< extra IDTs with wider basins, e.g. {60, 30}
-  bool suppress_pyramid = true;           ///< texture-suppress the pyramid IDTs
   // Texture suppression on the edge mask: edge pixels whose (2·density_window_px+1)² window is
   // denser than this share of edge pixels are dropped (foliage, gravel); 0 = keep all.
   double max_edge_density = 0.0;
@@ -58,11 +56,10 @@ std::string DetectorChoices();
 
 // The maps of one edge orientation (near-vertical or near-horizontal image edges).
 struct OrientedMaps {
-  cv::Mat idt;                   ///< CV_32F, smoothed IDT in [0, 255]
-  cv::Mat idt_suppressed;        ///< texture-suppressed IDT
-  cv::Mat idt_bandpass;          ///< IDT − wide blur, not clipped (see BandPass)
-  cv::Mat distance_px;           ///< smoothed min(D, basin) [px]
-  std::vector<cv::Mat> pyramid;  ///< IDTs at pyramid_basins_px (suppressed if asked)
+  cv::Mat idt;             ///< CV_32F, smoothed IDT in [0, 255]
+  cv::Mat idt_suppressed;  ///< texture-suppressed IDT
+  cv::Mat idt_bandpass;    ///< IDT − wide blur, not clipped (see BandPass)
+  cv::Mat distance_px;     ///< smoothed min(D, basin) [px]
 };
 
 struct ImageFeatures {
@@ -76,9 +73,7 @@ struct ImageFeatures {
   cv::Mat idt;             ///< CV_32F, smoothed IDT in [0, 255]
   cv::Mat idt_suppressed;  ///< CV_32F, max(0, IDT − wide blur of IDT): dense texture fades
   cv::Mat idt_bandpass;    ///< CV_32F, IDT − wide blur of IDT, not clipped (see BandPass)
-  std::vector<cv::Mat> idt_pyramid;  ///< IDTs at pyramid_basins_px (suppressed if asked);
-                                     ///< empty with split_orientation (see OrientedMaps)
-  std::vector<cv::Vec4f> segments;   ///< line segments at full-size coordinates (LSD/FLD)
+  std::vector<cv::Vec4f> segments;  ///< line segments at full-size coordinates (LSD/FLD)
   // With split_orientation: the maps of near-vertical [0] and near-horizontal [1] edges.
   std::array<OrientedMaps, 2> oriented;
   int edge_pixels = 0;  ///< after texture suppression

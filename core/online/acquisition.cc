@@ -123,7 +123,6 @@ const std::vector<Hypothesis>& Acquisition::Update(WindowScorer* search, WindowS
   // own search moves it), from the state a hypothesis of the same lattice rotation had.
   AdaptiveGridSearchOptions refine = options;
   refine.search_translation = false;
-  refine.first_level = search->num_levels() - 1;
   std::vector<Hypothesis> next;
   for (size_t k = 0; k <= top.size(); ++k) {
     // A lattice point outside the search's bounds (the lattice reaches half a step past the

@@ -51,7 +51,6 @@ Status FrameSourceOptions::Validate() const {
 
 ImageFeatureOptions FrameSourceOptions::ImageOptions() const {
   ImageFeatureOptions options = image;
-  options.suppress_pyramid = suppress_texture;
   options.split_orientation = oriented_maps;
   options.unsplit_maps = !oriented_maps;  // Load reads the oriented maps only
   return options;
@@ -129,8 +128,6 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   for (int kind = 0; kind < 2; ++kind) {
     const bool oriented = options_.oriented_maps && !out->image.empty();
     const OrientedMaps* m = oriented ? &out->image.oriented[kind] : nullptr;
-    const std::vector<cv::Mat>& pyramid = m ? m->pyramid : out->image.idt_pyramid;
-    for (const cv::Mat& level : pyramid) out->score_maps[kind].push_back(level);
     const cv::Mat& idt = m ? m->idt : out->image.idt;
     const cv::Mat& suppressed = options_.bandpass_score
                                     ? (m ? m->idt_bandpass : out->image.idt_bandpass)

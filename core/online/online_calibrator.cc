@@ -67,10 +67,10 @@ Status OnlineCalibratorOptions::Validate() const {
         start_uncertainty.time_offset_s > 0)) {
     return Status::Error("online: every start_uncertainty figure must be > 0");
   }
-  if (HypothesisLattice::CountFor(start_uncertainty, LatticeSteps()) >
-      HypothesisLattice::kMaxHypotheses) {
+  const Status fits = HypothesisLattice::CheckFits(start_uncertainty, LatticeSteps());
+  if (!fits.ok()) {
     return Status::Error("online: start_uncertainty " + StartUncertaintyText(start_uncertainty) +
-                         " makes a lattice too large for memory");
+                         ": " + fits.message());
   }
   STCALIB_RETURN_IF_ERROR(search.Validate());
   return refine.Validate();
@@ -346,7 +346,6 @@ bool OnlineCalibrator::Update(WindowScorer* scorer, bool full_step, FrameReport*
   const std::vector<const CalibrationFrame*> refine_window = RefineWindow();
   WindowScorer long_scorer(refine_window, ScoreOptionsInUse());
   AdaptiveGridSearchOptions search_options = options_.search;
-  search_options.first_level = scorer->num_levels() - 1;
   Search(scorer, &long_scorer, search_options, read_hypotheses, report);
   const auto start = std::chrono::steady_clock::now();
   report->refine = Refine(refine_window, report->search.state, report->search.state, anchor_,

@@ -58,13 +58,11 @@ SearchResult AdaptiveGridSearch(WindowScorer* scorer, const CalibrationState& st
   SearchResult result;
   result.state = start;
   result.start = scorer->Evaluate(start, -1);
-  const int levels = scorer->num_levels();
-  for (int level = std::clamp(options.first_level, 0, std::max(levels - 1, 0)); level < levels;
-       ++level) {
-    const bool finest = level == levels - 1;
-    const auto& directions = NeighbourDirections(options.search_translation &&
-                                                 (finest || !options.coarse_levels_rotation_only));
-    const bool search_time = options.search_time_offset && finest;
+  // The finest score map (the frames' last).
+  const int level = std::max(scorer->num_levels() - 1, 0);
+  {
+    const auto& directions = NeighbourDirections(options.search_translation);
+    const bool search_time = options.search_time_offset;
     CalibrationState& state = result.state;
     double current = objective(state, level);
     ++result.evaluations;

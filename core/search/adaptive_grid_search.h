@@ -15,9 +15,8 @@ namespace stcalib {
 // one (α1 rotation, α2 translation) while the gray rate is below γ and the small one (α3, α4)
 // above it. When a neighbour is better the search keeps moving in that direction while the score
 // improves (steepest-direction following), then looks around again; a 1-D search over the time
-// offset is interleaved. It runs coarse-to-fine over the score maps the frames carry (the
-// calibrator's carry the finest only: its hypothesis lattice, not the search, covers a start
-// several degrees off; docs/method.md §6).
+// offset is interleaved. It searches the frames' finest score map (their last): the hypothesis
+// lattice, not the search, covers a start several degrees off (docs/method.md §6).
 struct AdaptiveGridSearchOptions {
   double alpha1_rotation_deg = 1.0;    ///< large step pair: rotation [deg]
   double alpha2_translation_m = 0.04;  ///< large step pair: translation [m]
@@ -30,10 +29,6 @@ struct AdaptiveGridSearchOptions {
   bool search_time_offset = true;
   double time_offset_step_s = 0.004;  ///< δ line-search step [s]
   double time_offset_bound_s = 0.15;  ///< |δ| never exceeds this [s]
-  int first_level = 0;                ///< coarsest score map used (0 = all levels)
-  // Coarse levels search rotation only (translation is barely visible in wide basins and would
-  // wander); the finest level searches all six axes and δ.
-  bool coarse_levels_rotation_only = true;
   // Bounds around `anchor` (the mount / initial calibration): the search never leaves them.
   double max_rotation_offset_deg = 6.0;
   double max_translation_offset_m = 0.15;

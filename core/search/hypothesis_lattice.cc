@@ -71,15 +71,19 @@ size_t HypothesisLattice::CountFor(const StartUncertainty& span, const LatticeSt
   return count > 1e15 ? static_cast<size_t>(1e15) : static_cast<size_t>(count);
 }
 
+Status HypothesisLattice::CheckFits(const StartUncertainty& span, const LatticeSteps& steps,
+                                    size_t max_hypotheses) {
+  const size_t count = CountFor(span, steps);
+  if (count <= max_hypotheses) return Status::Ok();
+  return Status::Error("a lattice of " + std::to_string(count) +
+                       " hypotheses does not fit in memory (at most " +
+                       std::to_string(max_hypotheses) + "): narrow the start uncertainty");
+}
+
 Status HypothesisLattice::Create(const CalibrationState& centre, const StartUncertainty& span,
                                  const LatticeSteps& steps, HypothesisLattice* lattice,
                                  size_t max_hypotheses) {
-  const size_t count = CountFor(span, steps);
-  if (count > max_hypotheses) {
-    return Status::Error("a lattice of " + std::to_string(count) +
-                         " hypotheses is too large (at most " + std::to_string(max_hypotheses) +
-                         "): narrow the start uncertainty");
-  }
+  STCALIB_RETURN_IF_ERROR(CheckFits(span, steps, max_hypotheses));
   HypothesisLattice out;
   out.centre_ = centre;
   out.steps_ = steps;

@@ -57,6 +57,9 @@ class HypothesisLattice {
                        size_t max_hypotheses = kMaxHypotheses);
   // The number of hypotheses Create would make (no allocation).
   static size_t CountFor(const StartUncertainty& span, const LatticeSteps& steps);
+  // Error (naming the count and the limit) when that number exceeds `max_hypotheses`.
+  static Status CheckFits(const StartUncertainty& span, const LatticeSteps& steps,
+                          size_t max_hypotheses = kMaxHypotheses);
 
   size_t size() const { return rotations_.size() * time_offsets_s_.size() * translations_.size(); }
   size_t num_rotations() const { return rotations_.size(); }
