@@ -7,15 +7,15 @@
 #include <cstdio>
 
 #include "core/score/score.h"
+#include "core/types/enum_names.h"
+#include "core/types/format.h"
 
 namespace stcalib {
 namespace {
 
-std::string Format(const char* format, double a, double b = 0, double c = 0, double d = 0) {
-  char text[256];
-  std::snprintf(text, sizeof(text), format, a, b, c, d);
-  return text;
-}
+constexpr EnumNames<CheckAnswer, 3> kAnswerNames = {{{CheckAnswer::kHolds, "holds"},
+                                                     {CheckAnswer::kOff, "off"},
+                                                     {CheckAnswer::kCannotTell, "cannot tell"}}};
 
 // An axis offset in its display unit: degrees, centimetres, milliseconds.
 double DisplayValue(int axis, double value) {
@@ -59,17 +59,7 @@ double StudentT99(int dof) {
   return 2.326 + (2.528 - 2.326) * 20.0 / dof;
 }
 
-const char* CheckAnswerName(CheckAnswer answer) {
-  switch (answer) {
-    case CheckAnswer::kHolds:
-      return "holds";
-    case CheckAnswer::kOff:
-      return "off";
-    case CheckAnswer::kCannotTell:
-      return "cannot tell";
-  }
-  return "?";
-}
+std::string CheckAnswerName(CheckAnswer answer) { return EnumName(kAnswerNames, answer); }
 
 CalibrationCheckResult CheckCalibration(
     const std::vector<std::shared_ptr<const CalibrationFrame>>& frames,
@@ -120,8 +110,8 @@ CalibrationCheckResult CheckCalibration(
   const RefineJackknife rotation_spread =
       JackknifeRefine(used, rotation.state, calibration, rotation_options, result.block_frames,
                       /*min_frames=*/2);
-  const RefineJackknife full_spread = JackknifeRefine(
-      used, full.state, calibration, full_options, result.block_frames, /*min_frames=*/2);
+  const RefineJackknife full_spread = JackknifeRefine(used, full.state, calibration, full_options,
+                                                      result.block_frames, /*min_frames=*/2);
   const auto rotation_offsets = AxisOffsets(rotation.state, calibration);
   const auto full_offsets = AxisOffsets(full.state, calibration);
   const int blocks_measured = result.blocks - std::max(rotation_spread.failed, full_spread.failed);
@@ -159,16 +149,17 @@ CalibrationCheckResult CheckCalibration(
     if (!a.resolved) unresolved += (unresolved.empty() ? "" : ", ") + std::string(kAxisNames[axis]);
     if (axis >= 3 && a.off) {
       off_others += (off_others.empty() ? "" : ", ") + std::string(kAxisNames[axis]) +
-                    Format(" %+.1f ", DisplayValue(axis, a.offset)) + DisplayUnit(axis) +
-                    Format(" (std %.1f)", DisplayValue(axis, a.std));
+                    FormatNumbers(" %+.1f ", DisplayValue(axis, a.offset)) + DisplayUnit(axis) +
+                    FormatNumbers(" (std %.1f)", DisplayValue(axis, a.std));
     }
   }
-  const std::string evidence = Format("%.0f frames in %.0f blocks of %.0f, t = %.2f",
-                                      result.frames_used, result.blocks, result.block_frames, t);
-  const std::string rotation_text =
-      Format("the rotation lies %.2f deg from the drive's optimum (std %.2f deg along it; "
-             "tolerance %.2f deg)",
-             result.rotation_offset_deg, result.rotation_std_deg, options.tolerance_rotation_deg);
+  const std::string evidence =
+      FormatNumbers("%.0f frames in %.0f blocks of %.0f, t = %.2f", result.frames_used,
+                    result.blocks, result.block_frames, t);
+  const std::string rotation_text = FormatNumbers(
+      "the rotation lies %.2f deg from the drive's optimum (std %.2f deg along it; "
+      "tolerance %.2f deg)",
+      result.rotation_offset_deg, result.rotation_std_deg, options.tolerance_rotation_deg);
   if (rotation_off || !off_others.empty()) {
     result.answer = CheckAnswer::kOff;
     result.reason = rotation_off ? "off: " + rotation_text + " (" + evidence + ")"
@@ -180,8 +171,12 @@ CalibrationCheckResult CheckCalibration(
                     " to the tolerance (t·std over it); " + rotation_text + " (" + evidence + ")";
   } else {
     result.answer = CheckAnswer::kHolds;
-    result.reason = "holds: " + rotation_text + (unresolved_others.empty() ? "" : "; not resolved "
-                    "by this drive (not checked): " + unresolved_others) + " (" + evidence + ")";
+    result.reason = "holds: " + rotation_text +
+                    (unresolved_others.empty() ? ""
+                                               : "; not resolved "
+                                                 "by this drive (not checked): " +
+                                                     unresolved_others) +
+                    " (" + evidence + ")";
   }
   return result;
 }

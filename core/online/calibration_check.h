@@ -57,12 +57,12 @@ struct CalibrationCheckOptions {
 double StudentT99(int dof);
 
 enum class CheckAnswer { kHolds, kOff, kCannotTell };
-const char* CheckAnswerName(CheckAnswer answer);  ///< "holds", "off", "cannot tell"
+std::string CheckAnswerName(CheckAnswer answer);  ///< "holds", "off", "cannot tell"
 
 struct AxisCheck {
-  double offset = 0;     ///< the drive's optimum − the checked calibration (axis unit)
-  double std = 0;        ///< max(jackknife std, refinement std) (axis unit)
-  double tolerance = 0;  ///< (axis unit)
+  double offset = 0;      ///< the drive's optimum − the checked calibration (axis unit)
+  double std = 0;         ///< max(jackknife std, refinement std) (axis unit)
+  double tolerance = 0;   ///< (axis unit)
   bool resolved = false;  ///< t·std ≤ tolerance
   bool off = false;       ///< resolved and |offset| > tolerance + t·std (this axis alone)
 };

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/types/format.h"
+
 namespace stcalib {
 
 Status ConvergenceOptions::Validate() const {
@@ -46,12 +48,6 @@ TranslationMove TranslationMoveBeyondPrior(const CalibrationState& initial,
 }
 
 namespace {
-
-std::string Format(const char* format, double a, double b = 0, double c = 0, double d = 0) {
-  char text[512];
-  std::snprintf(text, sizeof(text), format, a, b, c, d);
-  return text;
-}
 
 using Rule = RuleOutcome (*)(const ConvergenceEvidence&, const ConvergenceOptions&);
 
@@ -109,12 +105,12 @@ RuleOutcome InsideBounds(const ConvergenceEvidence& e, const ConvergenceOptions&
   const bool at_rotation_bound =
       e.rotation_moved_deg >= e.rotation_bound_deg - o.rotation_bound_margin_deg;
   if (!at_time_bound && !at_rotation_bound) {
-    return {"inside_bounds", true, Format("moved %.3f deg", e.rotation_moved_deg)};
+    return {"inside_bounds", true, FormatNumbers("moved %.3f deg", e.rotation_moved_deg)};
   }
   std::string text = "the estimate ran to the bound of its " +
                      std::string(at_time_bound ? "time offset (|δ| = bound)" : "rotation search") +
                      ": the score has no trustworthy optimum inside the bounds";
-  if (!at_time_bound) text += Format(" (moved %.3f deg)", e.rotation_moved_deg);
+  if (!at_time_bound) text += FormatNumbers(" (moved %.3f deg)", e.rotation_moved_deg);
   return {"inside_bounds", false, text};
 }
 
@@ -155,16 +151,17 @@ RuleOutcome RotationProfiles(const ConvergenceEvidence& e, const ConvergenceOpti
   for (int axis = 0; axis < 3; ++axis) {
     const RotationAxisProfile& p = e.rotation_profiles[axis];
     if (std::abs(p.best_deg) > o.max_profile_offset_deg) {
-      return {
-          "rotation_profiles", false,
-          Format("the last frames' score peaks %+.2f deg away on ", p.best_deg) + kAxisNames[axis]};
+      return {"rotation_profiles", false,
+              FormatNumbers("the last frames' score peaks %+.2f deg away on ", p.best_deg) +
+                  kAxisNames[axis]};
     }
     if (p.ambiguous) {
-      return {"rotation_profiles", false,
-              std::string(kAxisNames[axis]) +
-                  Format(" is ambiguous: a second score peak %+.2f deg away reaches %.0f%% of "
-                         "the best",
-                         p.second_peak_deg, 100 * p.second_peak_ratio)};
+      return {
+          "rotation_profiles", false,
+          std::string(kAxisNames[axis]) +
+              FormatNumbers(" is ambiguous: a second score peak %+.2f deg away reaches %.0f%% of "
+                            "the best",
+                            p.second_peak_deg, 100 * p.second_peak_ratio)};
     }
   }
   return {"rotation_profiles", true, "each axis peaks at the estimate"};
@@ -182,7 +179,7 @@ RuleOutcome TimeOffsetProfileRule(const ConvergenceEvidence& e, const Convergenc
   }
   const double away_s = p.best_s - e.time_offset_s;
   const std::string text =
-      Format("the last frames' score over δ peaks %+.1f ms away", 1000 * away_s);
+      FormatNumbers("the last frames' score over δ peaks %+.1f ms away", 1000 * away_s);
   return {kTimeOffsetRule, std::abs(away_s) <= o.max_profile_offset_s, text};
 }
 
@@ -190,16 +187,18 @@ RuleOutcome TranslationWithinPrior(const ConvergenceEvidence& e, const Convergen
   const TranslationMove moved = TranslationMoveBeyond(
       e.translation_move_m, o.max_translation_move_sigmas, e.prior_sigma_translation_m);
   if (moved.axis < 0) {
-    return {"translation_within_prior", true,
-            Format("moved at most %.1f cm", 100 * e.translation_move_m.cwiseAbs().maxCoeff())};
+    return {
+        "translation_within_prior", true,
+        FormatNumbers("moved at most %.1f cm", 100 * e.translation_move_m.cwiseAbs().maxCoeff())};
   }
   return {"translation_within_prior", false,
-          Format("the translation moved %+.1f cm from the start on ", 100 * moved.move_m) +
+          FormatNumbers("the translation moved %+.1f cm from the start on ", 100 * moved.move_m) +
               kAxisNames[3 + moved.axis] +
-              Format(", more than %.1f times its prior's %.1f cm: the data overrules the prior (a "
-                     "wrong time offset can show up as a sideways shift); if the start may be "
-                     "that far off, widen the prior (--prior_sigma_translation_m)",
-                     o.max_translation_move_sigmas, 100 * e.prior_sigma_translation_m)};
+              FormatNumbers(
+                  ", more than %.1f times its prior's %.1f cm: the data overrules the prior (a "
+                  "wrong time offset can show up as a sideways shift); if the start may be "
+                  "that far off, widen the prior (--prior_sigma_translation_m)",
+                  o.max_translation_move_sigmas, 100 * e.prior_sigma_translation_m)};
 }
 
 RuleOutcome TranslationSpread(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
@@ -209,26 +208,26 @@ RuleOutcome TranslationSpread(const ConvergenceEvidence& e, const ConvergenceOpt
     if (widest < 0 || e.translation_spread_m[i] > e.translation_spread_m[widest]) widest = i;
   }
   const double spread_m = e.translation_spread_m[widest];
-  const std::string text = Format("%.1f cm on ", 100 * spread_m) + kAxisNames[3 + widest];
+  const std::string text = FormatNumbers("%.1f cm on ", 100 * spread_m) + kAxisNames[3 + widest];
   if (!(o.max_translation_spread_m > 0) || spread_m <= o.max_translation_spread_m) {
     return {"translation_spread", true, "the windows' translations across travel spread " + text};
   }
   return {"translation_spread", false,
           "the windows' refinements do not pin the translation down across travel: they spread " +
-              text + Format(" (more than %.1f cm)", 100 * o.max_translation_spread_m)};
+              text + FormatNumbers(" (more than %.1f cm)", 100 * o.max_translation_spread_m)};
 }
 
 RuleOutcome Health(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
-  const std::string text = Format("health %.3f ", e.final_health) +
+  const std::string text = FormatNumbers("health %.3f ", e.final_health) +
                            (e.final_health < o.min_final_health ? "<" : ">=") +
-                           Format(" %.2f", o.min_final_health);
+                           FormatNumbers(" %.2f", o.min_final_health);
   if (e.final_health >= o.min_final_health) return {"health", true, text};
   return {"health", false, text + " (the estimate is not a clear optimum of the score)"};
 }
 
 RuleOutcome Settled(const ConvergenceEvidence& e, const ConvergenceOptions& o) {
-  const std::string text =
-      Format("%.3f deg over the last ", e.settle_deg) + std::to_string(o.settle_frames) + " frames";
+  const std::string text = FormatNumbers("%.3f deg over the last ", e.settle_deg) +
+                           std::to_string(o.settle_frames) + " frames";
   if (e.settle_deg <= o.max_settle_deg) return {"settled", true, text};
   return {"settled", false, "still moving (" + text + ")"};
 }
@@ -242,16 +241,15 @@ RuleOutcome Jackknife(const ConvergenceEvidence& e, const ConvergenceOptions&) {
   const RefineJackknife& j = *e.rotation_jackknife;
   if (j.frames == 0) return {kJackknifeRule, true, "too few frames to leave a block out"};
   const std::string spread =
-      Format("the rotation's jackknife std over %.0f frames in %.0f blocks is ", j.frames,
-             j.blocks) +
-      Format("%.3f / %.3f / %.3f deg (roll / pitch / yaw)", j.std.x(), j.std.y(),
-             j.std.z());
+      FormatNumbers("the rotation's jackknife std over %.0f frames in %.0f blocks is ", j.frames,
+                    j.blocks) +
+      FormatNumbers("%.3f / %.3f / %.3f deg (roll / pitch / yaw)", j.std.x(), j.std.y(), j.std.z());
   for (int axis = 0; axis < 3; ++axis) {
     if (!(j.std[axis] < kMaxJackknifeStdDeg)) {
       return {kJackknifeRule, false,
               std::string(kAxisNames[axis]) + " is not pinned down by these frames: " + spread +
-                  Format(", over %.2f deg: leaving out a few frames moves the estimate",
-                         kMaxJackknifeStdDeg)};
+                  FormatNumbers(", over %.2f deg: leaving out a few frames moves the estimate",
+                                kMaxJackknifeStdDeg)};
     }
   }
   return {kJackknifeRule, true, spread};
