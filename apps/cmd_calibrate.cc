@@ -62,11 +62,31 @@ nlohmann::json PolishJson(const FrameReport& polish) {
 
 }  // namespace
 
+namespace {
+
+// "image_02,image_03" → its names (empty entries dropped).
+std::vector<std::string> SplitCameras(const std::string& list) {
+  std::vector<std::string> names;
+  std::string name;
+  for (char c : list + ",") {
+    if (c != ',') {
+      name += c;
+    } else if (!name.empty()) {
+      names.push_back(name);
+      name.clear();
+    }
+  }
+  return names;
+}
+
+}  // namespace
+
 CalibrateJob CalibrateJobFromFlags() {
   CalibrateJob job;
   job.drive_dir = FLAGS_drive;
   job.calib_dir = FLAGS_calib_dir;
   job.init_calib = FLAGS_init_calib;
+  job.cameras = SplitCameras(FLAGS_cameras);
   job.bag = BagOptionsFromFlags();
   job.out_dir = FLAGS_out;
   job.perturb_rot_deg = FLAGS_perturb_rot_deg;
@@ -152,28 +172,31 @@ std::string TimeOffsetPriorNote(const CalibrateOutcome& outcome) {
          numbers + "\n";
 }
 
-int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
-  const char* kCommand = "calibrate";
-  Status status = job.online.Validate();
-  if (status.ok()) status = job.convergence.Validate();
-  if (!status.ok()) return UsageError(kCommand, status.message());
+namespace {
+
+// One camera's run: its drive, start, calibrator and what its frames did.
+struct CameraRun {
   Drive drive;
-  status = job.bag.bag_dir.empty() ? OpenDrive(job.drive_dir, job.calib_dir, &drive)
-                                   : OpenBagDrive(job.bag, &drive);
-  if (!status.ok()) return ReportError(kCommand, status);
-  const int first = job.first_frame;
-  const int last =
-      job.num_frames > 0 ? first + job.num_frames - 1 : static_cast<int>(drive.NumFrames()) - 1;
-  if (first < 0 || first >= static_cast<int>(drive.NumFrames()) ||
-      last >= static_cast<int>(drive.NumFrames())) {
-    return ReportError(kCommand,
-                       Status::Error(drive.drive_dir + ": frames " + std::to_string(first) + ".." +
-                                     std::to_string(last) + " out of range (" +
-                                     std::to_string(drive.NumFrames()) + " frames)"));
-  }
-  // Reference: simulated ground truth when present, else the drive's own calibration.
-  status = ReadGroundTruth(drive, &outcome->has_truth, &outcome->reference_state);
-  if (!status.ok()) return ReportError(kCommand, status);
+  std::mt19937_64 rng;  ///< the start's signs, then the disturbance's
+  std::unique_ptr<OnlineCalibrator> calibrator;
+  std::shared_ptr<const CalibrationFrame> last_frame;
+  double frame_ms_sum = 0;
+  int frames_used = 0;
+  std::string out_dir;  ///< empty: nothing is written
+};
+
+// The rng of camera `k`'s start: camera 0's is the seed's own (a single-camera run's).
+std::mt19937_64 CameraRng(uint64_t seed, size_t k) {
+  return std::mt19937_64(k == 0 ? seed : seed ^ (0x9E3779B97F4A7C15ull * k));
+}
+
+// The camera's reference (simulated truth, else the drive's calibration) and start.
+Status StartCamera(const CalibrateJob& job, CameraRun* run, CalibrateOutcome* outcome) {
+  const Drive& drive = run->drive;
+  outcome->camera = drive.camera_name;
+  STCALIB_RETURN_IF_ERROR(ReadGroundTruth(drive, &outcome->has_truth, &outcome->reference_state));
+  outcome->T_rectified_camera = RectifiedFromCamera(drive.camera);
+  outcome->T_camera_reference = drive.camera.T_camera_reference;
   if (outcome->has_truth) {
     outcome->reference = "ground truth (simulated)";
   } else {
@@ -183,97 +206,28 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
                              : "drive calibration (" + drive.calib_dir + "/calib_velo_to_cam.txt)";
   }
   CalibrationState initial;
-  std::mt19937_64 rng(job.seed);
-  auto sign = [&]() { return (rng() & 1) ? 1.0 : -1.0; };
-  status = StartingCalibration(drive, job.init_calib, job.perturb_rot_deg, job.perturb_trans_m,
-                               &rng, &initial.T_camera_lidar);
-  if (!status.ok()) return ReportError(kCommand, status);
+  STCALIB_RETURN_IF_ERROR(StartingCalibration(drive, job.init_calib, job.perturb_rot_deg,
+                                              job.perturb_trans_m, &run->rng,
+                                              &initial.T_camera_lidar));
   initial.time_offset_s = job.perturb_time_s;
   outcome->initial = initial;
   outcome->initial_error = ComputeCalibrationError(initial, outcome->reference_state);
-  // The dynamic filter judges the camera's view as the starting calibration places it, widened
-  // by at least how far the estimate may turn from it (plus the pruning margin's few degrees).
-  FrameSourceOptions source_options = job.source;
-  source_options.view_T_camera_lidar = initial.T_camera_lidar;
-  if (source_options.view_margin_deg >= 0) {
-    source_options.view_margin_deg =
-        std::max(source_options.view_margin_deg, job.online.search.max_rotation_offset_deg + 10.0);
-  }
-  std::unique_ptr<DriveFrameSource> source;
-  status = DriveFrameSource::Create(&drive, source_options, &source);
-  if (!status.ok()) return ReportError(kCommand, status);
-  outcome->motion = source->motion().SourceName();
+  return Status::Ok();
+}
 
+// The camera's verdict and polish, and its outputs in run.out_dir; the camera's exit code.
+int FinishCamera(const CalibrateJob& job, int first, int last,
+                 std::chrono::steady_clock::time_point run_start, CameraRun* run,
+                 CalibrateOutcome* outcome) {
+  const char* kCommand = "calibrate";
+  const Drive& drive = run->drive;
+  OnlineCalibrator& calibrator = *run->calibrator;
+  const CalibrationState& initial = outcome->initial;
+  const int frames_used = run->frames_used;
+  const std::shared_ptr<const CalibrationFrame>& last_frame = run->last_frame;
+  outcome->mean_frame_ms = run->frame_ms_sum / std::max(1, frames_used);
   std::error_code ec;
-  if (!job.out_dir.empty()) {
-    fs::create_directories(job.out_dir, ec);
-    if (ec || !fs::is_directory(job.out_dir)) {
-      return ReportError(kCommand, Status::Error(job.out_dir + ": cannot create output folder"));
-    }
-  }
-
-  OnlineCalibrator calibrator(job.online, initial);
-  std::shared_ptr<const CalibrationFrame> last_frame;
-  const auto run_start = std::chrono::steady_clock::now();
-  double frame_ms_sum = 0;
-  int frames_used = 0;
-  // The next frame is read and its features computed on a second thread while this one is
-  // calibrated; a frame's time is the wait for it plus its calibration.
-  FramePrefetcher frames(source.get(), first, last);
-  FramePrefetcher::Loaded loaded;
-  for (auto t0 = std::chrono::steady_clock::now(); frames.Next(&loaded);
-       t0 = std::chrono::steady_clock::now()) {
-    const int i = loaded.index;
-    if (!loaded.status.ok()) {
-      // Bad data in one frame (unreadable sweep or image, oxts gap): keep the estimate, go on.
-      outcome->reports.push_back(calibrator.SkipFrame(i, loaded.status.message()));
-      continue;
-    }
-    std::shared_ptr<const CalibrationFrame> frame = std::move(loaded.frame);
-    if (i == job.disturb_frame) {
-      const Eigen::Vector3d d(sign() * job.disturb_rot_deg, sign() * job.disturb_rot_deg,
-                              sign() * job.disturb_rot_deg);
-      CalibrationState disturbed = calibrator.state();
-      disturbed.T_camera_lidar =
-          PerturbTcameraLidar(disturbed.T_camera_lidar, d, Eigen::Vector3d::Zero());
-      calibrator.SetState(disturbed);
-    }
-    // The last frame updates, so that the verdict reads a refinement over the latest frames (if
-    // it cannot be loaded, the verdict reads the last update's, at most
-    // tracking_update_every - 1 frames older).
-    FrameReport report = calibrator.AddFrame(frame, /*update_now=*/i == last);
-    frame_ms_sum +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (!report.skipped) {
-      last_frame = frame;
-      ++frames_used;
-    }
-    outcome->reports.push_back(report);
-    if (VLOG_IS_ON(1) && report.ran_update()) {
-      const CalibrationError es =
-          ComputeCalibrationError(report.search.state, outcome->reference_state);
-      const CalibrationError er =
-          ComputeCalibrationError(report.refine.state, outcome->reference_state);
-      VLOG(1) << "frame " << i << ": search " << ToString(es) << " | refine (usable "
-              << report.refine.usable << ", " << report.refine.iterations << " iterations, "
-              << report.refine.residuals << " residuals) " << ToString(er) << " | "
-              << report.reason;
-    }
-    if (job.progress) {
-      const CalibrationError e = ComputeCalibrationError(report.after, outcome->reference_state);
-      // An updating line on a terminal, one line per frame in a log.
-      const bool terminal = isatty(fileno(stderr));
-      std::fprintf(
-          stderr,
-          "%scalibrate: frame %d/%d  %s %.3f deg, %.3f m, dt %+.1f ms  gray %.2f  health %.2f   ",
-          terminal ? "\r" : "", i - first + 1, last - first + 1,
-          outcome->has_truth ? "error" : "vs drive calib", e.rotation_deg, e.translation_norm_m,
-          1000 * report.after.time_offset_s, report.gray_rate_after, report.health);
-      if (!terminal) std::fprintf(stderr, "\n");
-    }
-  }
-  if (job.progress && isatty(fileno(stderr))) std::fprintf(stderr, "\n");
-  outcome->mean_frame_ms = frame_ms_sum / std::max(1, frames_used);
+  Status status = Status::Ok();
   // The verdict, and the polish of a converged estimate (core/online/convergence.h): the app
   // only formats them.
   const ConvergenceVerdict verdict =
@@ -292,14 +246,17 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const ReportedUncertainty reported = ReportUncertainty(
       verdict, outcome->time_offset_estimated, job.online.refine.observable_translation_m);
   outcome->observable = reported.observable;
+  outcome->has_std = reported.has_std;
+  outcome->std_dev = reported.std_dev;
   auto verdict_code = [&]() {
     if (outcome->converged) return outcome->held_axes.empty() ? kExitOk : kExitPartial;
-    std::fprintf(stderr, "stcalib calibrate: %s\n", outcome->reason.c_str());
+    std::fprintf(stderr, "stcalib calibrate: %s%s\n", CameraPrefix(job, *outcome).c_str(),
+                 outcome->reason.c_str());
     return kExitFailure;
   };
   // docs/method.md §9: --out is optional; without it nothing is written (the caller prints the
   // estimate) and none of the files' contents are made.
-  if (job.out_dir.empty()) return verdict_code();
+  if (run->out_dir.empty()) return verdict_code();
   const TimeOffsetProfile& profile = verdict.time_offset_profile;
   nlohmann::json profiles_json;
   for (int axis = 0; axis < 3; ++axis) {
@@ -333,7 +290,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   const TimeForwardPair& pair = verdict.time_forward;
 
   // Outputs.
-  const std::string out = job.out_dir;
+  const std::string out = run->out_dir;
   auto fail = [&](const Status& s) { return ReportError(kCommand, s); };
   if (outcome->converged) {
     // A partial claim marks what it held in both files (the values there are the start's).
@@ -346,7 +303,10 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       }
     }
     if (!held.empty()) held = "held at the start (not observable in this drive): " + held;
-    status = WriteVeloToCam(out + "/calib_velo_to_cam.txt", outcome->estimate.T_camera_lidar, held);
+    // The file's frame is calib_velo_to_cam's own (KITTI's camera 0 for every KITTI camera).
+    status = WriteVeloToCam(
+        out + "/calib_velo_to_cam.txt",
+        drive.camera.T_camera_reference.inverse() * outcome->estimate.T_camera_lidar, held);
     if (!status.ok()) return fail(status);
     status = WriteTimeOffset(out + "/" + kTimeOffsetFileName, outcome->estimate.time_offset_s,
                              time_held);
@@ -482,6 +442,7 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
       {"stcalib_version", StcalibVersion()},
       {"command", CommandLineText()},
       {"input", job.bag.bag_dir.empty() ? job.drive_dir : job.bag.bag_dir},
+      {"camera", outcome->camera},
   };
   if (outcome->has_truth) {
     result["error"] = ErrorJson(outcome->error);
@@ -607,7 +568,246 @@ int RunCalibrateJob(const CalibrateJob& job, CalibrateOutcome* outcome) {
   return verdict_code();
 }
 
+}  // namespace
+
+RigCamera ToRigCamera(const CalibrateOutcome& outcome) {
+  RigCamera camera;
+  camera.name = outcome.camera;
+  camera.claimed = outcome.converged;
+  camera.T_camera_lidar = outcome.estimate.T_camera_lidar;
+  camera.T_rectified_camera = outcome.T_rectified_camera;
+  camera.T_camera_reference = outcome.T_camera_reference;
+  camera.std_dev = outcome.std_dev;
+  camera.has_std = outcome.has_std;
+  return camera;
+}
+
+Status WriteRigSummary(const CalibrateJob& job, const std::vector<CalibrateOutcome>& outcomes) {
+  nlohmann::json cameras = nlohmann::json::array();
+  for (const CalibrateOutcome& outcome : outcomes) {
+    const Eigen::Vector3d rpy_deg = MountRollPitchYawDeg(outcome.estimate.T_camera_lidar.linear());
+    nlohmann::json std_json;
+    for (int k = 0; k < kNumAxes; ++k) {
+      std_json[kAxisNames[k]] =
+          outcome.has_std[k] ? nlohmann::json(outcome.std_dev[k]) : nlohmann::json(nullptr);
+    }
+    cameras.push_back(
+        {{"camera", outcome.camera},
+         {"folder", outcome.camera},
+         {"converged", outcome.converged},
+         {"claim", !outcome.converged          ? "none"
+                   : outcome.held_axes.empty() ? "whole"
+                                               : "partial"},
+         {"held_axes", outcome.held_axes},
+         {"reason", outcome.reason},
+         {"T_camera_lidar", MatrixJson(outcome.estimate.T_camera_lidar)},
+         {"time_offset_s", outcome.estimate.time_offset_s},
+         {"rpy_deg", {{"roll", rpy_deg.x()}, {"pitch", rpy_deg.y()}, {"yaw", rpy_deg.z()}}},
+         {"std", std_json},
+         {"reference", outcome.reference},
+         {outcome.has_truth ? "error" : "agreement_with_drive_calibration",
+          ErrorJson(outcome.error)}});
+  }
+  nlohmann::json pairs = nlohmann::json::array();
+  for (size_t a = 0; a < outcomes.size(); ++a) {
+    for (size_t b = a + 1; b < outcomes.size(); ++b) {
+      const CameraPairCheck pair =
+          CompareCameraPair(ToRigCamera(outcomes[a]), ToRigCamera(outcomes[b]));
+      nlohmann::json entry = {{"from", pair.from},
+                              {"to", pair.to},
+                              {"compared", pair.compared},
+                              {"T_to_from_rig", MatrixJson(pair.T_to_from_rig)},
+                              {"baseline_rig_m", pair.T_to_from_rig.translation().norm()}};
+      if (pair.compared) {
+        entry["T_to_from_estimated"] = MatrixJson(pair.T_to_from_estimated);
+        entry["rotation_disagreement_deg"] = pair.rotation_deg;
+        entry["translation_disagreement_m"] = pair.translation_m;
+        entry["baseline_error_m"] = pair.baseline_m;
+        entry["rotation_disagreement_std_deg"] = pair.rotation_std_deg;
+        entry["translation_disagreement_std_m"] = pair.translation_std_m;
+      }
+      pairs.push_back(entry);
+    }
+  }
+  const nlohmann::json rig = {
+      {"cameras", cameras},
+      {"camera_pairs", pairs},
+      {"stcalib_version", StcalibVersion()},
+      {"command", CommandLineText()},
+      {"input", job.drive_dir},
+  };
+  return WriteTextFile(job.out_dir + "/result.json", rig.dump(2) + "\n");
+}
+
+std::string CameraPrefix(const CalibrateJob& job, const CalibrateOutcome& outcome) {
+  return job.cameras.size() > 1 ? outcome.camera + ": " : "";
+}
+
+int RunCalibrateJob(const CalibrateJob& job, std::vector<CalibrateOutcome>* outcomes) {
+  const char* kCommand = "calibrate";
+  Status status = job.online.Validate();
+  if (status.ok()) status = job.convergence.Validate();
+  if (!status.ok()) return UsageError(kCommand, status.message());
+  const std::vector<std::string> camera_names =
+      job.cameras.empty() ? std::vector<std::string>{"image_02"} : job.cameras;
+  if (!job.bag.bag_dir.empty() && camera_names.size() > 1) {
+    return UsageError(kCommand,
+                      "--cameras names KITTI camera folders of a --drive; a bag has one "
+                      "--image_topic");
+  }
+  const size_t n = camera_names.size();
+  std::vector<CameraRun> runs(n);
+  outcomes->assign(n, CalibrateOutcome());
+  for (size_t k = 0; k < n; ++k) {
+    status = job.bag.bag_dir.empty()
+                 ? OpenDrive(job.drive_dir, job.calib_dir, &runs[k].drive, camera_names[k])
+                 : OpenBagDrive(job.bag, &runs[k].drive);
+    if (!status.ok()) return ReportError(kCommand, status);
+  }
+  const Drive& drive = runs.front().drive;
+  const int first = job.first_frame;
+  const int last =
+      job.num_frames > 0 ? first + job.num_frames - 1 : static_cast<int>(drive.NumFrames()) - 1;
+  if (first < 0 || first >= static_cast<int>(drive.NumFrames()) ||
+      last >= static_cast<int>(drive.NumFrames())) {
+    return ReportError(kCommand,
+                       Status::Error(drive.drive_dir + ": frames " + std::to_string(first) + ".." +
+                                     std::to_string(last) + " out of range (" +
+                                     std::to_string(drive.NumFrames()) + " frames)"));
+  }
+  for (size_t k = 0; k < n; ++k) {
+    runs[k].rng = CameraRng(job.seed, k);
+    status = StartCamera(job, &runs[k], &(*outcomes)[k]);
+    if (!status.ok()) return ReportError(kCommand, status);
+  }
+  // The dynamic filter judges the cameras' view as the starting calibration places the first,
+  // widened by at least how far the estimate may turn from it (plus the pruning margin's few
+  // degrees).
+  FrameSourceOptions source_options = job.source;
+  source_options.view_T_camera_lidar = outcomes->front().initial.T_camera_lidar;
+  if (source_options.view_margin_deg >= 0) {
+    source_options.view_margin_deg =
+        std::max(source_options.view_margin_deg, job.online.search.max_rotation_offset_deg + 10.0);
+  }
+  std::vector<const Drive*> drives;
+  for (const CameraRun& run : runs) drives.push_back(&run.drive);
+  std::unique_ptr<DriveFrameSource> source;
+  status = DriveFrameSource::Create(drives, source_options, &source);
+  if (!status.ok()) return ReportError(kCommand, status);
+  for (CalibrateOutcome& outcome : *outcomes) outcome.motion = source->motion().SourceName();
+
+  std::error_code ec;
+  if (!job.out_dir.empty()) {
+    for (size_t k = 0; k < n; ++k) {
+      runs[k].out_dir = n == 1 ? job.out_dir : job.out_dir + "/" + camera_names[k];
+      fs::create_directories(runs[k].out_dir, ec);
+      if (ec || !fs::is_directory(runs[k].out_dir)) {
+        return ReportError(kCommand,
+                           Status::Error(runs[k].out_dir + ": cannot create output folder"));
+      }
+    }
+  }
+
+  for (size_t k = 0; k < n; ++k) {
+    runs[k].calibrator = std::make_unique<OnlineCalibrator>(job.online, (*outcomes)[k].initial);
+  }
+  const auto run_start = std::chrono::steady_clock::now();
+  // The next frame is read and its features computed on a second thread while this one is
+  // calibrated; a camera's frame time is its calibration plus its share of the wait for the frame.
+  FramePrefetcher frames(source.get(), first, last);
+  FramePrefetcher::Loaded loaded;
+  for (auto t0 = std::chrono::steady_clock::now(); frames.Next(&loaded);
+       t0 = std::chrono::steady_clock::now()) {
+    const int i = loaded.index;
+    const double wait_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    for (size_t k = 0; k < n; ++k) {
+      const auto camera_t0 = std::chrono::steady_clock::now();
+      CameraRun& run = runs[k];
+      CalibrateOutcome* outcome = &(*outcomes)[k];
+      OnlineCalibrator& calibrator = *run.calibrator;
+      CameraFrameLoad& camera_load = loaded.cameras[k];
+      if (!camera_load.status.ok()) {
+        // Bad data in one frame (unreadable sweep or image, oxts gap): keep the estimate, go on.
+        outcome->reports.push_back(calibrator.SkipFrame(i, camera_load.status.message()));
+        continue;
+      }
+      std::shared_ptr<const CalibrationFrame> frame = std::move(camera_load.frame);
+      if (i == job.disturb_frame) {
+        auto sign = [&]() { return (run.rng() & 1) ? 1.0 : -1.0; };
+        const Eigen::Vector3d d(sign() * job.disturb_rot_deg, sign() * job.disturb_rot_deg,
+                                sign() * job.disturb_rot_deg);
+        CalibrationState disturbed = calibrator.state();
+        disturbed.T_camera_lidar =
+            PerturbTcameraLidar(disturbed.T_camera_lidar, d, Eigen::Vector3d::Zero());
+        calibrator.SetState(disturbed);
+      }
+      // The last frame updates, so that the verdict reads a refinement over the latest frames
+      // (if it cannot be loaded, the verdict reads the last update's, at most
+      // tracking_update_every - 1 frames older).
+      FrameReport report = calibrator.AddFrame(frame, /*update_now=*/i == last);
+      run.frame_ms_sum += wait_ms / n + std::chrono::duration<double, std::milli>(
+                                            std::chrono::steady_clock::now() - camera_t0)
+                                            .count();
+      if (!report.skipped) {
+        run.last_frame = frame;
+        ++run.frames_used;
+      }
+      outcome->reports.push_back(report);
+      if (VLOG_IS_ON(1) && report.ran_update()) {
+        const CalibrationError es =
+            ComputeCalibrationError(report.search.state, outcome->reference_state);
+        const CalibrationError er =
+            ComputeCalibrationError(report.refine.state, outcome->reference_state);
+        VLOG(1) << CameraPrefix(job, *outcome) << "frame " << i << ": search " << ToString(es)
+                << " | refine (usable " << report.refine.usable << ", " << report.refine.iterations
+                << " iterations, " << report.refine.residuals << " residuals) " << ToString(er)
+                << " | " << report.reason;
+      }
+      if (job.progress) {
+        const CalibrationError e = ComputeCalibrationError(report.after, outcome->reference_state);
+        // An updating line on a terminal, one line per frame in a log.
+        const bool terminal = isatty(fileno(stderr)) && n == 1;
+        std::fprintf(stderr,
+                     "%scalibrate: %sframe %d/%d  %s %.3f deg, %.3f m, dt %+.1f ms  gray %.2f  "
+                     "health %.2f   ",
+                     terminal ? "\r" : "", CameraPrefix(job, *outcome).c_str(), i - first + 1,
+                     last - first + 1, outcome->has_truth ? "error" : "vs drive calib",
+                     e.rotation_deg, e.translation_norm_m, 1000 * report.after.time_offset_s,
+                     report.gray_rate_after, report.health);
+        if (!terminal) std::fprintf(stderr, "\n");
+      }
+    }
+  }
+  if (job.progress && isatty(fileno(stderr)) && n == 1) std::fprintf(stderr, "\n");
+  // The worst camera's code: a failure over a partial claim over a whole one.
+  int code = kExitOk;
+  for (size_t k = 0; k < n; ++k) {
+    const int camera_code = FinishCamera(job, first, last, run_start, &runs[k], &(*outcomes)[k]);
+    if (camera_code == kExitFailure || (camera_code != kExitOk && code == kExitOk)) {
+      code = camera_code;
+    }
+  }
+  if (n > 1 && !job.out_dir.empty()) {
+    status = WriteRigSummary(job, *outcomes);
+    if (!status.ok()) return ReportError(kCommand, status);
+  }
+  return code;
+}
+
 std::string CalibrateFlagsError() {
+  const std::vector<std::string> cameras = SplitCameras(FLAGS_cameras);
+  for (size_t k = 0; k < cameras.size(); ++k) {
+    if (!IsKittiCameraName(cameras[k])) {
+      return "--cameras: '" + cameras[k] + "' is not a KITTI camera folder (image_02, image_03, …)";
+    }
+    if (std::count(cameras.begin(), cameras.begin() + k, cameras[k]) > 0) {
+      return "--cameras names " + cameras[k] + " twice";
+    }
+  }
+  if (!FLAGS_bag.empty() && !cameras.empty()) {
+    return "--cameras names the camera folders of a --drive; a --bag has one --image_topic";
+  }
   for (const auto& [name, value] : {std::pair{"--loss", &FLAGS_loss}}) {
     RefineOptions::Loss loss;
     if (!ParseLoss(*value, &loss)) return std::string(name) + " must be " + LossChoices();
@@ -636,29 +836,57 @@ int RunCalibrate() {
   }
   const std::string flags_error = CalibrateFlagsError();
   if (!flags_error.empty()) return UsageError("calibrate", flags_error);
-  CalibrateOutcome outcome;
-  const int code = RunCalibrateJob(CalibrateJobFromFlags(), &outcome);
-  if (outcome.reports.empty()) return code;
-  const CalibrationError& e = outcome.error;
-  std::printf("%s after %zu frames (%s)\n",
-              !outcome.converged          ? "NOT converged"
-              : outcome.held_axes.empty() ? "converged"
-                                          : "PARTLY converged",
-              outcome.reports.size(), outcome.reason.c_str());
-  std::printf(
-      "%s: rotation %.3f deg (roll %+.3f, pitch %+.3f, yaw %+.3f), translation %.3f m, "
-      "time offset %+.2f ms (estimate %+.2f ms)\n",
-      outcome.has_truth ? "error vs ground truth" : "agreement with the drive calibration",
-      e.rotation_deg, e.roll_deg, e.pitch_deg, e.yaw_deg, e.translation_norm_m,
-      1000 * e.time_offset_s, 1000 * outcome.estimate.time_offset_s);
-  std::printf("%s", TimeOffsetPriorNote(outcome).c_str());
-  if (!FLAGS_out.empty()) {
-    std::printf("mean %.1f ms per frame; outputs in %s\n", outcome.mean_frame_ms,
-                FLAGS_out.c_str());
-  } else if (outcome.converged) {  // no --out: the estimate on stdout, nothing written
-    std::printf("mean %.1f ms per frame; no --out, so the estimate is printed here:\n%s",
-                outcome.mean_frame_ms, VeloToCamText(outcome.estimate.T_camera_lidar).c_str());
-    std::printf("time_offset_s: %.9f\n", outcome.estimate.time_offset_s);
+  const CalibrateJob job = CalibrateJobFromFlags();
+  std::vector<CalibrateOutcome> outcomes;
+  const int code = RunCalibrateJob(job, &outcomes);
+  for (const CalibrateOutcome& outcome : outcomes) {
+    if (outcome.reports.empty()) return code;
+    const std::string camera = CameraPrefix(job, outcome);
+    const CalibrationError& e = outcome.error;
+    std::printf("%s%s after %zu frames (%s)\n", camera.c_str(),
+                !outcome.converged          ? "NOT converged"
+                : outcome.held_axes.empty() ? "converged"
+                                            : "PARTLY converged",
+                outcome.reports.size(), outcome.reason.c_str());
+    std::printf(
+        "%s%s: rotation %.3f deg (roll %+.3f, pitch %+.3f, yaw %+.3f), translation %.3f m, "
+        "time offset %+.2f ms (estimate %+.2f ms)\n",
+        camera.c_str(),
+        outcome.has_truth ? "error vs ground truth" : "agreement with the drive calibration",
+        e.rotation_deg, e.roll_deg, e.pitch_deg, e.yaw_deg, e.translation_norm_m,
+        1000 * e.time_offset_s, 1000 * outcome.estimate.time_offset_s);
+    std::printf("%s%s", TimeOffsetPriorNote(outcome).empty() ? "" : camera.c_str(),
+                TimeOffsetPriorNote(outcome).c_str());
+    if (!FLAGS_out.empty()) {
+      std::printf("%smean %.1f ms per frame; outputs in %s\n", camera.c_str(),
+                  outcome.mean_frame_ms,
+                  (outcomes.size() > 1 ? FLAGS_out + "/" + outcome.camera : FLAGS_out).c_str());
+    } else if (outcome.converged) {  // no --out: the estimate on stdout, nothing written
+      std::printf(
+          "%smean %.1f ms per frame; no --out, so the estimate is printed here:\n%s",
+          camera.c_str(), outcome.mean_frame_ms,
+          VeloToCamText(outcome.T_camera_reference.inverse() * outcome.estimate.T_camera_lidar)
+              .c_str());
+      std::printf("time_offset_s: %.9f\n", outcome.estimate.time_offset_s);
+    }
+  }
+  // The rig: each pair of cameras as their estimates place them against the rig's own.
+  for (size_t a = 0; a < outcomes.size(); ++a) {
+    for (size_t b = a + 1; b < outcomes.size(); ++b) {
+      const CameraPairCheck pair =
+          CompareCameraPair(ToRigCamera(outcomes[a]), ToRigCamera(outcomes[b]));
+      if (!pair.compared) {
+        std::printf("%s to %s: not compared (not both claimed)\n", pair.from.c_str(),
+                    pair.to.c_str());
+        continue;
+      }
+      std::printf(
+          "%s to %s against the rig's calibration: rotation %.3f deg (expected spread %.3f), "
+          "translation %.3f m (expected spread %.3f), baseline %+.3f m of %.3f\n",
+          pair.from.c_str(), pair.to.c_str(), pair.rotation_deg, pair.rotation_std_deg,
+          pair.translation_m, pair.translation_std_m, pair.baseline_m,
+          pair.T_to_from_rig.translation().norm());
+    }
   }
   return code;
 }

@@ -51,9 +51,10 @@ int RunDemo() {
   job.num_frames = 0;
   std::printf("2/2 calibrating from +-2 deg on roll, pitch and yaw, +-5 cm, time offset 0\n");
   std::fflush(stdout);
-  CalibrateOutcome outcome;
-  const int code = RunCalibrateJob(job, &outcome);
-  if (outcome.reports.empty()) return code;
+  std::vector<CalibrateOutcome> outcomes;
+  const int code = RunCalibrateJob(job, &outcomes);
+  if (outcomes.empty() || outcomes.front().reports.empty()) return code;
+  const CalibrateOutcome& outcome = outcomes.front();
 
   // `observable`: per axis (kAxisNames order), whether to print the value; an axis the tool
   // could not observe is shown as "held" (it rests on its start or prior, it is no estimate).

@@ -127,7 +127,7 @@ int RunInfo() {
         bag ? "T_lidar_imu (odometry or IMU frame)" : "T_lidar_imu (calib_imu_to_velo.txt)",
         drive.T_lidar_imu);
   }
-  const auto& P = drive.camera.P_rect_02;
+  const auto& P = drive.camera.P_rect;
   std::printf("  P_rect_02 fx %.3f fy %.3f cx %.3f cy %.3f, tx %.4f\n", P(0, 0), P(1, 1), P(0, 2),
               P(1, 2), P(0, 3));
   return kExitOk;

@@ -1,6 +1,7 @@
 // stcalib simulate: a KITTI-raw drive with exact ground truth.
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 
 #include "apps/commands.h"
 #include "apps/flags.h"
@@ -34,6 +35,15 @@ int RunSimulate() {
     return UsageError("simulate",
                       "--lidar must be " + sim::SimLidarChoices() + ", got '" + FLAGS_lidar + "'");
   }
+  if (!FLAGS_cameras.empty()) {  // simulate reads --cameras as the rig's number of cameras
+    char* end = nullptr;
+    const long cameras = std::strtol(FLAGS_cameras.c_str(), &end, 10);
+    if (*end != '\0' || cameras < 1 || cameras > 4) {
+      return UsageError("simulate", "--cameras must be a number of cameras from 1 to 4, got '" +
+                                        FLAGS_cameras + "'");
+    }
+    options.cameras = static_cast<int>(cameras);
+  }
   options.distortion_k1 = FLAGS_distortion_k1;
   options.speed_mps = FLAGS_speed_mps;
   const Status valid = options.Validate();
@@ -50,12 +60,12 @@ int RunSimulate() {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf(
-      "simulated %d frames (scene %s, camera %s, lidar %s, seed %llu, time offset %+.4f s, %d "
-      "moving objects) in %.1f s\ndrive: %s\n",
+      "simulated %d frames (scene %s, camera %s x %d, lidar %s, seed %llu, time offset %+.4f s, "
+      "%d moving objects) in %.1f s\ndrive: %s\n",
       options.frames, sim::SceneTypeName(options.scene).c_str(),
-      sim::SimCameraName(options.camera).c_str(), sim::SimLidarName(options.lidar).c_str(),
-      static_cast<unsigned long long>(options.seed), options.time_offset_s, options.dynamic_objects,
-      seconds, drive_dir.c_str());
+      sim::SimCameraName(options.camera).c_str(), options.cameras,
+      sim::SimLidarName(options.lidar).c_str(), static_cast<unsigned long long>(options.seed),
+      options.time_offset_s, options.dynamic_objects, seconds, drive_dir.c_str());
   return kExitOk;
 }
 

@@ -61,14 +61,15 @@ Status WriteFrameStrip(const Drive& drive,
 int ReportError(const std::string& command, const Status& status);
 // Prints a usage error and returns kExitUsage.
 int UsageError(const std::string& command, const std::string& message);
-// Reads ground_truth.json beside a simulated drive's calibration; *found is false (and the
-// status ok) when the drive has none.
+// Reads ground_truth.json beside a simulated drive's calibration (for a camera other than
+// image_02, its entry under `cameras`); *found is false (and the status ok) when the drive has
+// none.
 Status ReadGroundTruth(const Drive& drive, bool* found, CalibrationState* truth);
 // The LiDAR a simulated drive's ground_truth.json names ("hdl64", "vlp16", "os1-64"); empty for a
 // drive without one (or one simulated before the key existed).
 Status ReadSimulatedLidarName(const Drive& drive, std::string* lidar);
-// The calibration a run starts from: `init_calib` (a calib_velo_to_cam.txt; empty: the drive's
-// own), perturbed by ±perturb_rot_deg on roll, pitch and yaw and ±perturb_trans_m on x, y, z with
+// The calibration a run starts from, in the camera's own frame: `init_calib` (a
+// calib_velo_to_cam.txt, carried by the camera's rig transform; empty: the drive's own), perturbed by ±perturb_rot_deg on roll, pitch and yaw and ±perturb_trans_m on x, y, z with
 // signs drawn from `rng` (in that order).
 Status StartingCalibration(const Drive& drive, const std::string& init_calib,
                            double perturb_rot_deg, double perturb_trans_m, std::mt19937_64* rng,

@@ -47,6 +47,15 @@ Status ReadGroundTruth(const Drive& drive, bool* found, CalibrationState* truth)
   nlohmann::json j;
   STCALIB_RETURN_IF_ERROR(ReadJson(path, &j));
   try {
+    // A simulated rig's other cameras have their own entry (their frame, their δ).
+    if (drive.camera_name != "image_02") {
+      if (!j.contains("cameras") || !j["cameras"].contains(drive.camera_name)) {
+        return Status::Error(path + ": no ground truth for camera " + drive.camera_name +
+                             " (its 'cameras' entry)");
+      }
+      const nlohmann::json camera = j["cameras"][drive.camera_name];
+      j = camera;
+    }
     const auto& m = j.at("T_camera_lidar");
     if (m.size() != 16) return Status::Error(path + ": T_camera_lidar must have 16 numbers");
     Eigen::Matrix4d T;
@@ -73,7 +82,12 @@ Status StartingCalibration(const Drive& drive, const std::string& init_calib,
                            double perturb_rot_deg, double perturb_trans_m, std::mt19937_64* rng,
                            Rigid3d* T_camera_lidar) {
   *T_camera_lidar = drive.T_camera_lidar;
-  if (!init_calib.empty()) STCALIB_RETURN_IF_ERROR(ReadVeloToCam(init_calib, T_camera_lidar));
+  if (!init_calib.empty()) {
+    // The file's frame is calib_velo_to_cam's (KITTI's camera 0), the camera's own after its
+    // rig transform.
+    STCALIB_RETURN_IF_ERROR(ReadVeloToCam(init_calib, T_camera_lidar));
+    *T_camera_lidar = drive.camera.T_camera_reference * *T_camera_lidar;
+  }
   auto sign = [&]() { return ((*rng)() & 1) ? 1.0 : -1.0; };
   // One draw per statement, last axis first: the order every seed's start was drawn in so far
   // (the arguments of one call are evaluated in an order C++ leaves open).

@@ -63,6 +63,11 @@ DEFINE_double(max_edge_density, stcalib::ImageFeatureOptions().max_edge_density,
               "features, calibrate, demo, check: drop edge pixels in windows denser than this "
               "share (texture, any detector), 0 = off");
 // calibrate
+DEFINE_string(cameras, "",
+              "calibrate: KITTI camera folders to calibrate in one pass over the LiDAR, comma "
+              "separated (image_02,image_03); each gets OUT/<camera>/, the rig OUT/result.json "
+              "(default: image_02 alone, outputs in OUT). simulate: the rig's number of cameras, "
+              "1-4 (image_02 ahead, image_03 left, image_04 right, image_05 rear; default 1)");
 DEFINE_string(init_calib, "", "calibrate: initial calib_velo_to_cam.txt (default: the drive's)");
 DEFINE_double(perturb_rot_deg, 0.0,
               "calibrate: add this roll/pitch/yaw error (random signs) [deg]");

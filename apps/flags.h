@@ -29,6 +29,7 @@ DECLARE_double(oxts_error_scale);
 DECLARE_string(detector);
 DECLARE_double(min_segment_px);
 DECLARE_double(max_edge_density);
+DECLARE_string(cameras);
 DECLARE_string(init_calib);
 DECLARE_string(init_uncertainty);
 DECLARE_double(perturb_rot_deg);

@@ -67,11 +67,12 @@ const std::vector<Subcommand>& Subcommands() {
        "--out=DIR [--frames=N (40)] [--seed=S (1)] [--time_offset_s=X (0)] "
        "[--dynamic_objects=K (6)] [--scene=urban|poles|open] [--lidar_hz=10] "
        "[--camera=kitti|kitti_1003|hd720] [--lidar=hdl64|vlp16|os1-64] [--distortion_k1=K] "
-       "[--speed_mps=V] [--oxts_white_position_m=0.001] [--oxts_error_scale=1]",
+       "[--speed_mps=V] [--oxts_white_position_m=0.001] [--oxts_error_scale=1] [--cameras=N (1)]",
        "a KITTI-raw drive with exact ground truth (extrinsic, time offset, motion, labels)",
        &RunSimulate,
        {"out", "frames", "seed", "time_offset_s", "dynamic_objects", "scene", "camera", "lidar",
-        "distortion_k1", "speed_mps", "lidar_hz", "oxts_white_position_m", "oxts_error_scale"}},
+        "cameras", "distortion_k1", "speed_mps", "lidar_hz", "oxts_white_position_m",
+        "oxts_error_scale"}},
       {"features",
        "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T) "
        "--frame=I --out=DIR",
@@ -81,8 +82,8 @@ const std::vector<Subcommand>& Subcommands() {
         "odom_topic"}},
       {"calibrate",
        "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T "
-       "[--camera_info_topic=T] [--odom_topic=T | --imu_topic=T]) [--init_calib=FILE] "
-       "[--perturb_rot_deg=D] "
+       "[--camera_info_topic=T] [--odom_topic=T | --imu_topic=T]) [--cameras=image_02,image_03] "
+       "[--init_calib=FILE] [--perturb_rot_deg=D] "
        "[--perturb_trans_m=M] [--perturb_time_s=S] [--init_uncertainty=DEG,M,S] [--seed=S] "
        "[--first_frame=I] [--num_frames=N] [--out=DIR] [--flagfile=configs/X.flags]",
        "online calibration of rotation, translation and time offset; with --out writes the "
@@ -93,6 +94,7 @@ const std::vector<Subcommand>& Subcommands() {
         "bag",
         "image_topic",
         "cloud_topic",
+        "cameras",
         "init_calib",
         "out",
         "first_frame",

@@ -205,9 +205,10 @@ void BM_CalibrateLoopPerFrame(benchmark::State& state) {
     FramePrefetcher prefetcher(source.get(), 0, frames - 1);
     FramePrefetcher::Loaded loaded;
     while (prefetcher.Next(&loaded)) {
-      if (!loaded.status.ok()) return state.SkipWithError(loaded.status.message().c_str());
+      if (!loaded.cameras[0].status.ok())
+        return state.SkipWithError(loaded.cameras[0].status.message().c_str());
       const FrameReport report =
-          calibrator.AddFrame(std::move(loaded.frame), loaded.index == frames - 1);
+          calibrator.AddFrame(std::move(loaded.cameras[0].frame), loaded.index == frames - 1);
       search_ms += report.search_ms;
       refine_ms += report.refine_ms;
       updates += report.ran_update();

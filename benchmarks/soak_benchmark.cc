@@ -61,9 +61,11 @@ void BM_SoakReplayedDrive(benchmark::State& state) {
       FramePrefetcher prefetcher(source.get(), 0, last);
       FramePrefetcher::Loaded loaded;
       while (prefetcher.Next(&loaded)) {
-        if (!loaded.status.ok()) return state.SkipWithError(loaded.status.message().c_str());
-        loaded.frame->camera_time_s += cycle * (frames * 0.1 + 1.0);  // a loop after the last
-        const FrameReport report = calibrator.AddFrame(std::move(loaded.frame));
+        if (!loaded.cameras[0].status.ok())
+          return state.SkipWithError(loaded.cameras[0].status.message().c_str());
+        loaded.cameras[0].frame->camera_time_s +=
+            cycle * (frames * 0.1 + 1.0);  // a loop after the last
+        const FrameReport report = calibrator.AddFrame(std::move(loaded.cameras[0].frame));
         if (report.skipped) return state.SkipWithError(report.reason.c_str());
         updates += report.ran_update();
         ++added;

@@ -94,7 +94,7 @@ class EdgeAlignmentCost : public ceres::CostFunction {
         maps_(maps),
         outside_px_(outside_px),
         loss_(loss),
-        K_(camera->P_rect_02.leftCols<3>() * camera->R_rect_00),
+        K_(camera->P_rect.leftCols<3>() * camera->R_rect_00),
         depth_row_(camera->R_rect_00.row(2)) {
     CHECK(!points_.empty());
     for (Point& point : points_) {
@@ -121,7 +121,7 @@ class EdgeAlignmentCost : public ceres::CostFunction {
     // p_c = R·(R_v·p + t_v) + t = A·p + b; h = K·p_c + p4.
     const Eigen::Matrix3d A = R * Tv.linear();
     const Eigen::Vector3d b = R * Tv.translation() + t;
-    const Eigen::Vector3d p4 = camera_->P_rect_02.col(3);
+    const Eigen::Vector3d p4 = camera_->P_rect.col(3);
     double* j_pose = jacobians != nullptr ? jacobians[0] : nullptr;
     double* j_delta = jacobians != nullptr ? jacobians[1] : nullptr;
     Eigen::Matrix<double, 3, 4> m_transpose;            // ∂θ → ∂q (see the header)

@@ -67,7 +67,7 @@ TEST(BagDrive, KittiThroughTheBagIsTheSameDrive) {
   ASSERT_EQ(bag.NumFrames(), kitti.NumFrames());
   EXPECT_EQ(bag.camera_stamps_ns, kitti.camera_stamps_ns);
   EXPECT_EQ(bag.lidar_stamps_ns, kitti.lidar_stamps_ns);
-  EXPECT_TRUE(bag.camera.P_rect_02.isApprox(kitti.camera.P_rect_02, 1e-15));
+  EXPECT_TRUE(bag.camera.P_rect.isApprox(kitti.camera.P_rect, 1e-15));
   EXPECT_TRUE(bag.camera.R_rect_00.isApprox(kitti.camera.R_rect_00, 1e-15));
   EXPECT_EQ(bag.camera.image_width, kitti.camera.image_width);
   EXPECT_TRUE(bag.camera.distortion_model.empty());
@@ -429,7 +429,7 @@ TEST(BagDrive, CameraInfoRectifiesARawImageOntoP) {
     std::vector<cv::Point3d> object{{X.x(), X.y(), X.z()}};
     std::vector<cv::Point2d> raw;
     cv::projectPoints(object, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D, raw);
-    const Eigen::Vector3d q = camera.P_rect_02 * (camera.R_rect_00 * X).homogeneous();
+    const Eigen::Vector3d q = camera.P_rect * (camera.R_rect_00 * X).homogeneous();
     const int u = static_cast<int>(std::lround(q.x() / q.z()));
     const int v = static_cast<int>(std::lround(q.y() / q.z()));
     // The map at the rectified pixel reads the raw image where the point is (the rounding of the
@@ -446,7 +446,7 @@ TEST(BagDrive, CameraInfoRectifiesARawImageOntoP) {
     std::vector<cv::Point3d> object{{X.x(), X.y(), X.z()}};
     std::vector<cv::Point2d> raw;
     cv::fisheye::projectPoints(object, raw, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D4);
-    const Eigen::Vector3d q = camera.P_rect_02 * (camera.R_rect_00 * X).homogeneous();
+    const Eigen::Vector3d q = camera.P_rect * (camera.R_rect_00 * X).homogeneous();
     const int u = static_cast<int>(std::lround(q.x() / q.z()));
     const int v = static_cast<int>(std::lround(q.y() / q.z()));
     EXPECT_NEAR(maps.map_x.at<float>(v, u), raw[0].x, 0.8);

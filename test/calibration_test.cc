@@ -48,7 +48,7 @@ TEST(FrameSource, CameraAzimuthWindowHoldsTheFieldOfView) {
   Drive drive;
   ASSERT_TRUE(testing::OpenKittiDrive(&drive));
   const CameraCalibration& camera = drive.camera;
-  const double fx = camera.P_rect_02(0, 0), cx = camera.P_rect_02(0, 2);
+  const double fx = camera.P_rect(0, 0), cx = camera.P_rect(0, 2);
   const double half_fov_deg = std::atan(std::max(cx, camera.image_width - cx) / fx) * 180.0 / M_PI;
   EXPECT_NEAR(half_fov_deg, 41.2, 0.1);
   const Eigen::Vector2d ahead = CameraAzimuthWindowDeg(
@@ -126,14 +126,14 @@ TEST(FramePrefetcher, ReturnsTheFramesInOrderAsADirectLoadDoes) {
   for (int k = 0; k < 3; ++k) {
     ASSERT_TRUE(prefetcher.Next(&loaded));
     EXPECT_EQ(loaded.index, 3 + k);
-    ASSERT_TRUE(loaded.status.ok()) << loaded.status.message();
-    EXPECT_EQ(loaded.frame->camera_time_s, direct[k]->camera_time_s);
-    EXPECT_EQ(loaded.frame->e0_s, direct[k]->e0_s);
-    ASSERT_EQ(loaded.frame->size(), direct[k]->size());
-    EXPECT_EQ(loaded.frame->points_lidar, direct[k]->points_lidar);
+    ASSERT_TRUE(loaded.cameras[0].status.ok()) << loaded.cameras[0].status.message();
+    EXPECT_EQ(loaded.cameras[0].frame->camera_time_s, direct[k]->camera_time_s);
+    EXPECT_EQ(loaded.cameras[0].frame->e0_s, direct[k]->e0_s);
+    ASSERT_EQ(loaded.cameras[0].frame->size(), direct[k]->size());
+    EXPECT_EQ(loaded.cameras[0].frame->points_lidar, direct[k]->points_lidar);
     for (int kind = 0; kind < 2; ++kind) {
-      EXPECT_EQ(cv::norm(loaded.frame->score_maps[kind].back(), direct[k]->score_maps[kind].back(),
-                         cv::NORM_INF),
+      EXPECT_EQ(cv::norm(loaded.cameras[0].frame->score_maps[kind].back(),
+                         direct[k]->score_maps[kind].back(), cv::NORM_INF),
                 0.0);
     }
   }
@@ -158,11 +158,11 @@ TEST(FramePrefetcher, ReturnsAFrameThatFailsWithItsError) {
   FramePrefetcher prefetcher(source.get(), 0, 2);
   std::vector<FramePrefetcher::Loaded> all(3);
   for (FramePrefetcher::Loaded& loaded : all) ASSERT_TRUE(prefetcher.Next(&loaded));
-  EXPECT_TRUE(all[0].status.ok()) << all[0].status.message();
-  EXPECT_FALSE(all[1].status.ok());
-  EXPECT_THAT(all[1].status.message(), ::testing::HasSubstr(bin));
+  EXPECT_TRUE(all[0].cameras[0].status.ok()) << all[0].cameras[0].status.message();
+  EXPECT_FALSE(all[1].cameras[0].status.ok());
+  EXPECT_THAT(all[1].cameras[0].status.message(), ::testing::HasSubstr(bin));
   EXPECT_EQ(all[1].index, 1);
-  EXPECT_TRUE(all[2].status.ok()) << all[2].status.message();
+  EXPECT_TRUE(all[2].cameras[0].status.ok()) << all[2].cameras[0].status.message();
 }
 
 // Fault injection at the calibrator itself: frames that go back in time, repeat a stamp, carry
@@ -202,7 +202,7 @@ TEST(OnlineCalibrator, RefusesBadFramesAndKeepsTheEstimate) {
 // calibration, the second one a fold; point i lies at x = 0.1 i.
 std::shared_ptr<CalibrationFrame> FrameWithAFold(int index, double time_s) {
   auto frame = BareFrame(index, time_s);
-  frame->camera.P_rect_02 << 10, 0, 32, 0, 0, 10, 16, 0, 0, 0, 1, 0;
+  frame->camera.P_rect << 10, 0, 32, 0, 0, 10, 16, 0, 0, 0, 1, 0;
   for (int i = 0; i < 4; ++i) {
     frame->points_lidar.push_back(Eigen::Vector3d(0.1 * i, 0, 5));
     frame->kinds.push_back(i % 2 ? EdgeKind::kHorizontal : EdgeKind::kVertical);

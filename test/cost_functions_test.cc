@@ -128,7 +128,7 @@ struct SyntheticMap {
 
 CameraModel TestCamera() {
   CameraModel camera;
-  camera.P_rect_02 << 700, 0, 600, 45, 0, 700, 180, 0.2, 0, 0, 1, 0.003;
+  camera.P_rect << 700, 0, 600, 45, 0, 700, 180, 0.2, 0, 0, 1, 0.003;
   camera.R_rect_00 =
       Eigen::AngleAxisd(0.01, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   camera.width = 1200;
@@ -148,7 +148,7 @@ TEST(EdgeAlignmentCost, NominalValueByHand) {
   // A linear map D = 0.01·u + 0.02·v + 1 (bicubic interpolation reproduces it exactly).
   const SyntheticMap map(1200, 360, [](double u, double v) { return 0.01 * u + 0.02 * v + 1; });
   CameraModel camera;
-  camera.P_rect_02 << 700, 0, 600, 0, 0, 700, 180, 0, 0, 0, 1, 0;
+  camera.P_rect << 700, 0, 600, 0, 0, 700, 180, 0, 0, 0, 1, 0;
   camera.width = 1200;
   camera.height = 360;
   LidarTwist twist;

@@ -622,7 +622,7 @@ TEST(LidarEdges, EmptyAndDegenerateInputGiveEmptyFeatures) {
   EXPECT_EQ(f.rings.num_rings(), 0);
   // Every point behind the camera: nothing projects, nothing aligns, nothing crashes.
   CameraModel camera;
-  camera.P_rect_02 << 700, 0, 600, 0, 0, 700, 180, 0, 0, 0, 1, 0;
+  camera.P_rect << 700, 0, 600, 0, 0, 700, 180, 0, 0, 0, 1, 0;
   camera.width = 1200;
   camera.height = 360;
   std::vector<Eigen::Vector3d> behind(100, Eigen::Vector3d(0, 0, -5));

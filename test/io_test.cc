@@ -58,9 +58,9 @@ TEST(KittiReaders, CalibrationFilesHoldKnownValues) {
   EXPECT_EQ(camera.file.Text("calib_time"), "09-Jan-2012 13:57:47");
   EXPECT_DOUBLE_EQ(camera.R_rect_00(0, 1), 9.837760e-03);
   EXPECT_DOUBLE_EQ(camera.R_rect_00(2, 2), 9.999631e-01);
-  EXPECT_DOUBLE_EQ(camera.P_rect_02(0, 0), 7.215377e+02);
-  EXPECT_DOUBLE_EQ(camera.P_rect_02(0, 3), 4.485728e+01);
-  EXPECT_DOUBLE_EQ(camera.P_rect_02(2, 3), 2.745884e-03);
+  EXPECT_DOUBLE_EQ(camera.P_rect(0, 0), 7.215377e+02);
+  EXPECT_DOUBLE_EQ(camera.P_rect(0, 3), 4.485728e+01);
+  EXPECT_DOUBLE_EQ(camera.P_rect(2, 3), 2.745884e-03);
   EXPECT_EQ(camera.image_width, 1242);
   EXPECT_EQ(camera.image_height, 375);
   Eigen::MatrixXd D_03;

@@ -15,7 +15,7 @@ TEST(Projection, HandComputedPoint) {
   CameraModel camera;
   // R_rect_00: 90° about the camera z axis would be unusual; use a small known rotation instead:
   // identity here, so that the arithmetic below stays by hand.
-  camera.P_rect_02 << 700, 0, 600, 45, 0, 700, 170, 0.2, 0, 0, 1, 0.003;
+  camera.P_rect << 700, 0, 600, 45, 0, 700, 170, 0.2, 0, 0, 1, 0.003;
   camera.width = 1242;
   camera.height = 375;
   // KITTI-like axes: camera x = −lidar y, camera y = −lidar z, camera z = lidar x.
@@ -38,7 +38,7 @@ TEST(Projection, HandComputedPoint) {
 
 TEST(Projection, RectificationRotationIsApplied) {
   CameraModel camera;
-  camera.P_rect_02 << 100, 0, 50, 0, 0, 100, 50, 0, 0, 0, 1, 0;
+  camera.P_rect << 100, 0, 50, 0, 0, 100, 50, 0, 0, 0, 1, 0;
   camera.width = 100;
   camera.height = 100;
   camera.R_rect_00 = Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()).toRotationMatrix();

@@ -63,7 +63,7 @@ struct EdgeDistance {
 
 // Distances from projected, motion-compensated LiDAR edge points to Canny edges.
 EdgeDistance MeasureEdgeDistance(const Simulator& sim, const SimulatedFrame& f,
-                                 const Rigid3d& T_camera_lidar) {
+                                 const Rigid3d& T_camera_lidar, const cv::Mat& image_bgr) {
   const std::vector<int> edges =
       StaticEdgePoints(f.sweep, sim.lidar_model().azimuth_step_deg * M_PI / 180.0);
   const Rigid3d T_lidar_at_camera_inv = TWorldLidar(sim, f.camera_time_s).inverse();
@@ -75,12 +75,12 @@ EdgeDistance MeasureEdgeDistance(const Simulator& sim, const SimulatedFrame& f,
   }
   CameraModel camera;
   camera.R_rect_00 = sim.camera_rig().R_rect_00;
-  camera.P_rect_02 = sim.camera_rig().P_rect_02;
-  camera.width = f.image_bgr.cols;
-  camera.height = f.image_bgr.rows;
+  camera.P_rect = sim.camera_rig().P_rect;
+  camera.width = image_bgr.cols;
+  camera.height = image_bgr.rows;
   const std::vector<ProjectedPoint> projected = ProjectPoints(camera, T_camera_lidar, points);
   cv::Mat gray, canny, distance;
-  cv::cvtColor(f.image_bgr, gray, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(image_bgr, gray, cv::COLOR_BGR2GRAY);
   cv::Canny(gray, canny, 40, 120);
   cv::distanceTransform(255 - canny, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   std::vector<double> d;
@@ -116,13 +116,13 @@ TEST(Simulator, LidarEdgesLieOnImageEdgesWithTruth) {
       const SimulatedFrame f = sim.SimulateFrame(frame);
       EXPECT_EQ(f.image_bgr.cols, rig.width) << name;
       EXPECT_EQ(f.image_bgr.rows, rig.height) << name;
-      const EdgeDistance truth = MeasureEdgeDistance(sim, f, sim.T_camera_lidar());
+      const EdgeDistance truth = MeasureEdgeDistance(sim, f, sim.T_camera_lidar(), f.image_bgr);
       EXPECT_GT(truth.count, 200u) << name << " frame " << frame;
       EXPECT_LE(truth.median_px, 1.5) << name << " frame " << frame;
       // The same measure sees a 1° error: the check can fail.
       const Rigid3d wrong = PerturbTcameraLidar(sim.T_camera_lidar(), Eigen::Vector3d(0, 0.7, 0.7),
                                                 Eigen::Vector3d::Zero());
-      const EdgeDistance off = MeasureEdgeDistance(sim, f, wrong);
+      const EdgeDistance off = MeasureEdgeDistance(sim, f, wrong, f.image_bgr);
       EXPECT_LT(off.within_1_5px, truth.within_1_5px - 0.15) << name << " frame " << frame;
       std::printf(
           "%s frame %d: median %.2f px, %.0f%% within 1.5 px (truth); "
@@ -369,6 +369,78 @@ TEST(NavigationError, DriftRateIsTheDerivativeAndSigmaIsAsSet) {
   EXPECT_EQ(NavigationError().PositionDrift(3.0), Eigen::Vector3d::Zero());
 }
 
+// A rig of four cameras: each camera's LiDAR edges lie on its own image's edges with its own true
+// extrinsic (and not 1° off it); the cameras face ahead, left, right and rear.
+TEST(Simulator, RigCamerasSeeTheLidarEdgesWithTheirTruth) {
+  SimulatorOptions options = SmallOptions(5, 12);
+  options.cameras = 4;
+  const Simulator sim(options);
+  ASSERT_EQ(sim.rig_cameras().size(), 3u);
+  const SimulatedFrame f = sim.SimulateFrame(8);
+  ASSERT_EQ(f.rig_images_bgr.size(), 3u);
+  const double turns_deg[3] = {90, 90, 180};
+  for (size_t k = 0; k < 3; ++k) {
+    const SimRigCamera& camera = sim.rig_cameras()[k];
+    // Its optical axis turned from image_02's by the mount's turn (within the ±0.5° wobble).
+    const Eigen::Vector3d axis = camera.T_camera_reference.linear().transpose().col(2);
+    EXPECT_NEAR(std::acos(axis.z()) * 180 / M_PI, turns_deg[k], 1.0) << camera.name;
+    EXPECT_NEAR(camera.time_offset_s, options.time_offset_s, 0.02) << camera.name;
+    const EdgeDistance truth =
+        MeasureEdgeDistance(sim, f, camera.T_camera_lidar, f.rig_images_bgr[k]);
+    EXPECT_GT(truth.count, 100u) << camera.name;
+    EXPECT_LE(truth.median_px, 1.5) << camera.name;
+    const Rigid3d wrong = PerturbTcameraLidar(camera.T_camera_lidar, Eigen::Vector3d(0, 0.7, 0.7),
+                                              Eigen::Vector3d::Zero());
+    const EdgeDistance off = MeasureEdgeDistance(sim, f, wrong, f.rig_images_bgr[k]);
+    EXPECT_LT(off.within_1_5px, truth.within_1_5px - 0.1) << camera.name;
+    std::printf(
+        "%s: %zu points, median %.2f px, %.0f%% within 1.5 px (truth); %.0f%% (1 deg off)\n",
+        camera.name.c_str(), truth.count, truth.median_px, 100 * truth.within_1_5px,
+        100 * off.within_1_5px);
+  }
+}
+
+// The rig's cameras round-trip through the KITTI reader: each camera's folder, stamps (its δ),
+// calibration keys and ground truth.
+TEST(Simulator, RigDriveRoundTripsThroughTheKittiReader) {
+  ScopedTempDir tmp;
+  SimulatorOptions options = SmallOptions(7, 3);
+  options.cameras = 3;
+  std::string drive_dir;
+  const Status status = WriteSimulatedDrive(options, tmp.path(), &drive_dir);
+  ASSERT_TRUE(status.ok()) << status.message();
+  const Simulator sim(options);
+  for (size_t k = 0; k < sim.rig_cameras().size(); ++k) {
+    const SimRigCamera& camera = sim.rig_cameras()[k];
+    Drive drive;
+    const Status open = OpenDrive(drive_dir, "", &drive, camera.name);
+    ASSERT_TRUE(open.ok()) << open.message();
+    EXPECT_EQ(drive.camera_name, camera.name);
+    EXPECT_LT(
+        (drive.T_camera_lidar.matrix() - camera.T_camera_lidar.matrix()).cwiseAbs().maxCoeff(),
+        1e-9);
+    const nlohmann::json truth =
+        nlohmann::json::parse(testing::ReadFile(drive.calib_dir + "/ground_truth.json"));
+    EXPECT_DOUBLE_EQ(truth["cameras"][camera.name]["time_offset_s"].get<double>(),
+                     camera.time_offset_s);
+    for (int i = 0; i < 3; ++i) {
+      const SimulatedFrame f = sim.SimulateFrame(i);
+      EXPECT_EQ(drive.camera_stamps_ns[i], f.rig_camera_stamps_ns[k]);
+      // δ_k: the LiDAR stamp + δ_k − the camera's stamp is the true gap to the true image time.
+      EXPECT_NEAR(
+          NsToSeconds(drive.lidar_stamps_ns[i] - drive.camera_stamps_ns[i]) + camera.time_offset_s,
+          f.lidar_mid_time_s - f.camera_time_s, 2e-9);
+      cv::Mat image;
+      ASSERT_TRUE(drive.LoadImage(i, &image).ok());
+      EXPECT_EQ(cv::norm(image, f.rig_images_bgr[k], cv::NORM_INF), 0.0);
+    }
+  }
+  Drive missing;
+  const Status open = OpenDrive(drive_dir, "", &missing, "image_05");
+  ASSERT_FALSE(open.ok());
+  EXPECT_THAT(open.message(), ::testing::HasSubstr("camera image_05"));
+}
+
 TEST(Simulator, DriveRoundTripsThroughTheKittiReader) {
   ScopedTempDir tmp;
   const SimulatorOptions options = SmallOptions(7, 3);
@@ -385,7 +457,7 @@ TEST(Simulator, DriveRoundTripsThroughTheKittiReader) {
             1e-11);
   EXPECT_LT((drive.T_lidar_imu.matrix() - sim.T_lidar_imu().matrix()).cwiseAbs().maxCoeff(), 1e-11);
   EXPECT_EQ(drive.camera.image_width, 1242);
-  EXPECT_LT((drive.camera.P_rect_02 - sim.camera_rig().P_rect_02).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((drive.camera.P_rect - sim.camera_rig().P_rect).cwiseAbs().maxCoeff(), 1e-9);
   for (int i = 0; i < 3; ++i) {
     const SimulatedFrame f = sim.SimulateFrame(i);
     EXPECT_EQ(drive.camera_stamps_ns[i], f.camera_stamp_ns);

@@ -217,14 +217,14 @@ Status WriteDriveAsBag(const Drive& drive, const std::string& bag_dir, CloudLayo
   info.height = static_cast<uint32_t>(drive.camera.image_height);
   info.distortion_model = "plumb_bob";
   info.d.assign(5, 0.0);
-  info.K = drive.camera.P_rect_02.leftCols<3>();
+  info.K = drive.camera.P_rect.leftCols<3>();
   if (!drive.camera.distortion_model.empty()) {  // raw images: their model goes with them
     info.distortion_model = drive.camera.distortion_model;
     info.d = drive.camera.distortion;
     info.K = drive.camera.K;
   }
   info.R = drive.camera.R_rect_00;
-  info.P = drive.camera.P_rect_02;
+  info.P = drive.camera.P_rect;
   const double sweep_s = SweepDurationSeconds(drive);
   const OxtsOrigin origin =
       odometry ? OxtsOrigin{drive.oxts.front().lat, drive.oxts.front().lon, drive.oxts.front().alt}

@@ -267,9 +267,9 @@ Status CameraFromInfo(const RosCameraInfo& info, CameraCalibration* camera, Rect
                          " × " + std::to_string(info.height));
   }
   camera->R_rect_00 = info.R.isZero() ? Eigen::Matrix3d::Identity() : info.R;
-  camera->P_rect_02 = info.P;
-  if (info.P.isZero()) camera->P_rect_02.leftCols<3>() = info.K;
-  if (!(camera->P_rect_02(0, 0) > 0 && camera->P_rect_02(1, 1) > 0)) {
+  camera->P_rect = info.P;
+  if (info.P.isZero()) camera->P_rect.leftCols<3>() = info.K;
+  if (!(camera->P_rect(0, 0) > 0 && camera->P_rect(1, 1) > 0)) {
     return Status::Error("sensor_msgs/msg/CameraInfo: P (and K) have no positive focal length");
   }
   const bool distorted =

@@ -3,6 +3,7 @@
 #include <glog/logging.h>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 
 #include "core/io/image.h"
@@ -60,7 +61,7 @@ Status ReadStamps(const std::string& path, size_t num_frames, std::vector<StampN
 }  // namespace
 
 std::string Drive::ImagePath(size_t frame) const {
-  return drive_dir + "/image_02/data/" + frame_names.at(frame) + ".png";
+  return drive_dir + "/" + camera_name + "/data/" + frame_names.at(frame) + ".png";
 }
 
 std::string Drive::VelodynePath(size_t frame) const {
@@ -101,8 +102,20 @@ Status Drive::LoadScan(size_t frame, LidarScan* scan) const {
   return ReadVelodyneBin(VelodynePath(frame), scan);
 }
 
-Status OpenDrive(const std::string& drive_dir_in, const std::string& calib_dir_in, Drive* drive) {
+bool IsKittiCameraName(const std::string& name) {
+  return name.size() == 8 && name.compare(0, 6, "image_") == 0 && std::isdigit(name[6]) &&
+         std::isdigit(name[7]);
+}
+
+Status OpenDrive(const std::string& drive_dir_in, const std::string& calib_dir_in, Drive* drive,
+                 const std::string& camera) {
   *drive = Drive();
+  if (!IsKittiCameraName(camera)) {
+    return Status::Error("camera '" + camera +
+                         "' is not a KITTI camera folder name (image_ and two digits, e.g. "
+                         "image_02)");
+  }
+  drive->camera_name = camera;
   std::error_code ec;
   std::string drive_dir = drive_dir_in;
   while (drive_dir.size() > 1 && drive_dir.back() == '/') drive_dir.pop_back();
@@ -114,7 +127,10 @@ Status OpenDrive(const std::string& drive_dir_in, const std::string& calib_dir_i
       calib_dir_in.empty() ? fs::path(drive_dir).parent_path().string() : calib_dir_in;
   if (drive->calib_dir.empty()) drive->calib_dir = ".";
 
-  const std::string image_dir = drive_dir + "/image_02";
+  const std::string image_dir = drive_dir + "/" + camera;
+  if (!fs::is_directory(image_dir, ec)) {
+    return Status::Error(drive_dir + ": camera " + camera + ": folder " + image_dir + " not found");
+  }
   const std::string velo_dir = drive_dir + "/velodyne_points";
   const std::string oxts_dir = drive_dir + "/oxts";
   STCALIB_RETURN_IF_ERROR(ListFrames(image_dir + "/data", ".png", &drive->frame_names));
@@ -149,11 +165,13 @@ Status OpenDrive(const std::string& drive_dir_in, const std::string& calib_dir_i
   }
 
   const std::string cam_to_cam = drive->calib_dir + "/calib_cam_to_cam.txt";
-  STCALIB_RETURN_IF_ERROR(ReadCamToCam(cam_to_cam, &drive->camera));
+  STCALIB_RETURN_IF_ERROR(ReadCamToCam(cam_to_cam, &drive->camera, camera.substr(6))
+                              .WithContext("camera " + camera + ": "));
   STCALIB_RETURN_IF_ERROR(
       MakeRectifyMaps(drive->camera, &drive->rectify).WithContext(cam_to_cam + ": "));
   STCALIB_RETURN_IF_ERROR(
       ReadVeloToCam(drive->calib_dir + "/calib_velo_to_cam.txt", &drive->T_camera_lidar));
+  drive->T_camera_lidar = drive->camera.T_camera_reference * drive->T_camera_lidar;
   const std::string imu_path = drive->calib_dir + "/calib_imu_to_velo.txt";
   if (fs::exists(imu_path, ec)) {
     STCALIB_RETURN_IF_ERROR(ReadImuToVelo(imu_path, &drive->T_lidar_imu));

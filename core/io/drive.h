@@ -40,23 +40,28 @@ struct ImuSample {
   Eigen::Vector3d rate_rad_s = Eigen::Vector3d::Zero();
 };
 
-// A drive: KITTI raw synced (OpenDrive) or a ROS 2 bag read as one (OpenBagDrive, whose `store`
-// serves the images and sweeps). KITTI's: image_02/, velodyne_points/ and (optionally) oxts/, each
-// with data/ and timestamps.txt, plus the three calibration files in `calib_dir` (by default the
-// drive's parent folder). Frame i is the i-th file of image_02/data in name order; every sensor
-// must hold the same frame names and one stamp per frame.
+// A drive as one camera and the LiDAR see it: KITTI raw synced (OpenDrive) or a ROS 2 bag read as
+// one (OpenBagDrive, whose `store` serves the images and sweeps). KITTI's: the camera's folder
+// (image_02/ by default), velodyne_points/ and (optionally) oxts/, each with data/ and
+// timestamps.txt, plus the three calibration files in `calib_dir` (by default the drive's parent
+// folder). Frame i is the i-th file of the camera's data/ in name order; every sensor must hold
+// the same frame names and one stamp per frame. Several cameras of one drive are several Drives
+// (one per camera) that share the LiDAR (DriveFrameSource::Create reads it once).
 struct Drive {
   std::string drive_dir;
   std::string calib_dir;
+  std::string camera_name = "image_02";  ///< the camera's folder (KITTI) or image topic (a bag)
   std::vector<std::string> frame_names;  ///< e.g. "0000000000"
 
   CameraCalibration camera;
-  RectifyMaps rectify;  ///< raw image_02 to rectified (camera.distortion_model set), else empty
-  Rigid3d T_camera_lidar = Rigid3d::Identity();  ///< from calib_velo_to_cam.txt
-  bool has_imu_calibration = false;              ///< calib_imu_to_velo.txt read (oxts need it)
-  Rigid3d T_lidar_imu = Rigid3d::Identity();     ///< from calib_imu_to_velo.txt
+  RectifyMaps rectify;  ///< raw images to rectified (camera.distortion_model set), else empty
+  // LiDAR to the camera's frame: calib_velo_to_cam.txt, carried to the camera's own frame when it
+  // is not camera 0's (CameraCalibration::T_camera_reference).
+  Rigid3d T_camera_lidar = Rigid3d::Identity();
+  bool has_imu_calibration = false;           ///< calib_imu_to_velo.txt read (oxts need it)
+  Rigid3d T_lidar_imu = Rigid3d::Identity();  ///< from calib_imu_to_velo.txt
 
-  std::vector<StampNs> camera_stamps_ns;       ///< image_02/timestamps.txt
+  std::vector<StampNs> camera_stamps_ns;       ///< <camera>/timestamps.txt
   std::vector<StampNs> lidar_stamps_ns;        ///< velodyne_points/timestamps.txt
   std::vector<StampNs> lidar_start_stamps_ns;  ///< timestamps_start.txt (empty if absent)
   std::vector<StampNs> lidar_end_stamps_ns;    ///< timestamps_end.txt (empty if absent)
@@ -85,8 +90,13 @@ struct Drive {
   Status CheckFrame(size_t frame) const;
 };
 
-// Opens a drive: lists frames, reads every stamp file, the oxts packets and the calibration.
-// `calib_dir` empty means the parent of `drive_dir`.
-Status OpenDrive(const std::string& drive_dir, const std::string& calib_dir, Drive* drive);
+// Opens a drive as `camera` sees it ("image_02", "image_03", …: its folder, and "02", "03", … in
+// calib_cam_to_cam.txt's keys): lists frames, reads every stamp file, the oxts packets and the
+// calibration. `calib_dir` empty means the parent of `drive_dir`. Errors name the camera when its
+// folder or keys are missing.
+Status OpenDrive(const std::string& drive_dir, const std::string& calib_dir, Drive* drive,
+                 const std::string& camera = "image_02");
+// Whether `name` names a KITTI camera folder: "image_" and two digits.
+bool IsKittiCameraName(const std::string& name);
 
 }  // namespace stcalib

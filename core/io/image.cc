@@ -44,7 +44,7 @@ Status MakeRectifyMaps(const CameraCalibration& camera, RectifyMaps* maps) {
   cv::Mat K, R, P, D(1, static_cast<int>(camera.distortion.size()), CV_64F);
   cv::eigen2cv(camera.K, K);
   cv::eigen2cv(camera.R_rect_00, R);
-  const Eigen::Matrix3d P3 = camera.P_rect_02.leftCols<3>();
+  const Eigen::Matrix3d P3 = camera.P_rect.leftCols<3>();
   cv::eigen2cv(P3, P);
   for (size_t k = 0; k < camera.distortion.size(); ++k)
     D.at<double>(static_cast<int>(k)) = camera.distortion[k];

@@ -165,40 +165,58 @@ Status CheckRotation(const Eigen::Matrix3d& rotation, const std::string& what) {
   return Status::Ok();
 }
 
-Status ReadCamToCam(const std::string& path, CameraCalibration* calibration) {
+Status ReadCamToCam(const std::string& path, CameraCalibration* calibration,
+                    const std::string& id) {
   *calibration = CameraCalibration();
+  calibration->id = id;
   STCALIB_RETURN_IF_ERROR(KittiCalibFile::Read(path, &calibration->file));
   const KittiCalibFile& file = calibration->file;
+  const std::string p_key = "P_rect_" + id, s_key = "S_rect_" + id;
   Eigen::MatrixXd R_rect, P_rect, size;
   STCALIB_RETURN_IF_ERROR(file.GetMatrix("R_rect_00", 3, 3, &R_rect));
-  STCALIB_RETURN_IF_ERROR(file.GetMatrix("P_rect_02", 3, 4, &P_rect));
-  STCALIB_RETURN_IF_ERROR(file.GetMatrix("S_rect_02", 1, 2, &size));
+  STCALIB_RETURN_IF_ERROR(file.GetMatrix(p_key, 3, 4, &P_rect));
+  STCALIB_RETURN_IF_ERROR(file.GetMatrix(s_key, 1, 2, &size));
   STCALIB_RETURN_IF_ERROR(CheckRotation(R_rect, path + ": key 'R_rect_00'"));
   calibration->R_rect_00 = R_rect;
-  calibration->P_rect_02 = P_rect;
+  calibration->P_rect = P_rect;
   const double width = size(0, 0), height = size(0, 1);
   if (width < 1 || height < 1 || width > 100000 || height > 100000 ||
       width != static_cast<int>(width) || height != static_cast<int>(height)) {
-    return Status::Error(path + ": key 'S_rect_02' is not a valid image size");
+    return Status::Error(path + ": key '" + s_key + "' is not a valid image size");
   }
   calibration->image_width = static_cast<int>(width);
   calibration->image_height = static_cast<int>(height);
   if (P_rect(0, 0) <= 0 || P_rect(1, 1) <= 0 || P_rect(2, 2) <= 0) {
-    return Status::Error(path + ": key 'P_rect_02' has non-positive focal lengths");
+    return Status::Error(path + ": key '" + p_key + "' has non-positive focal lengths");
   }
-  // stcalib's key for raw image_02 images (a simulated distorted camera): KITTI's own files carry
-  // K_02 and D_02 too, but their image_02 is rectified, and they have no such key.
-  const std::string model = file.Text("distortion_model_02");
+  // stcalib's key for raw images (a simulated distorted camera): KITTI's own files carry K_02 and
+  // D_02 too, but their images are rectified, and they have no such key.
+  const std::string model = file.Text("distortion_model_" + id);
   if (!model.empty()) {
     Eigen::MatrixXd K;
-    STCALIB_RETURN_IF_ERROR(file.GetMatrix("K_02", 3, 3, &K));
-    if (!file.Has("D_02"))
-      return Status::Error(path + ": key 'D_02' missing (distortion_model_02)");
+    STCALIB_RETURN_IF_ERROR(file.GetMatrix("K_" + id, 3, 3, &K));
+    if (!file.Has("D_" + id)) {
+      return Status::Error(path + ": key 'D_" + id + "' missing (distortion_model_" + id + ")");
+    }
     calibration->distortion_model = model;
     calibration->K = K;
-    calibration->distortion = file.numbers().at("D_02");
+    calibration->distortion = file.numbers().at("D_" + id);
+  }
+  // stcalib's rig keys (a simulated rig): the camera's frame relative to calib_velo_to_cam's.
+  const std::string r_key = "R_rig_" + id, t_key = "T_rig_" + id;
+  if (file.Has(r_key) || file.Has(t_key)) {
+    Eigen::MatrixXd R, T;
+    STCALIB_RETURN_IF_ERROR(file.GetMatrix(r_key, 3, 3, &R));
+    STCALIB_RETURN_IF_ERROR(file.GetMatrix(t_key, 3, 1, &T));
+    STCALIB_RETURN_IF_ERROR(CheckRotation(R, path + ": key '" + r_key + "'"));
+    calibration->T_camera_reference = MakeRigid(NearestRotation(R), T.col(0));
   }
   return Status::Ok();
+}
+
+Rigid3d RectifiedFromCamera(const CameraCalibration& calibration) {
+  const Eigen::Matrix3d K = calibration.P_rect.leftCols<3>();
+  return MakeRigid(calibration.R_rect_00, K.inverse() * calibration.P_rect.col(3));
 }
 
 Status ReadVeloToCam(const std::string& path, Rigid3d* T_camera_lidar) {

@@ -42,22 +42,35 @@ class KittiCalibFile {
   std::map<std::string, int> lines_;
 };
 
-// calib_cam_to_cam.txt: the rectification and projection of the colour camera image_02.
+// calib_cam_to_cam.txt, for one camera: the rectification R_rect_00 and the camera's own
+// P_rect_<id> and S_rect_<id> (id "02" for image_02, "03" for image_03).
 struct CameraCalibration {
+  std::string id = "02";  ///< the camera's number in the file's keys
   Eigen::Matrix3d R_rect_00 = Eigen::Matrix3d::Identity();
-  Eigen::Matrix<double, 3, 4> P_rect_02 = Eigen::Matrix<double, 3, 4>::Zero();
-  int image_width = 0;   ///< from S_rect_02 [px]
-  int image_height = 0;  ///< from S_rect_02 [px]
+  Eigen::Matrix<double, 3, 4> P_rect = Eigen::Matrix<double, 3, 4>::Zero();  ///< P_rect_<id>
+  int image_width = 0;   ///< from S_rect_<id> [px]
+  int image_height = 0;  ///< from S_rect_<id> [px]
   KittiCalibFile file;   ///< every key of the file
   // A camera whose images are raw, not rectified (a bag's CameraInfo): its model ("plumb_bob",
   // "rational_polynomial", "equidistant"), matrix and coefficients, which RectifyImage
-  // (core/io/image.h) undoes onto P_rect_02. Empty model: the images are rectified (KITTI's).
+  // (core/io/image.h) undoes onto P_rect. Empty model: the images are rectified (KITTI's).
   std::string distortion_model;
   Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
   std::vector<double> distortion;
+  // The camera's frame (the one P_rect·R_rect_00 projects from) relative to the frame of
+  // calib_velo_to_cam.txt, x_camera = R·x + T: stcalib's keys R_rig_<id> and T_rig_<id>, for a
+  // rig whose cameras turn away from camera 0 (a simulated rig, docs/simulator.md). Identity
+  // without them, as for KITTI's cameras, which all project from camera 0's frame.
+  Rigid3d T_camera_reference = Rigid3d::Identity();
 };
 
-Status ReadCamToCam(const std::string& path, CameraCalibration* calibration);
+// calib_cam_to_cam.txt's keys for camera `id` ("02"); errors name the file and the key.
+Status ReadCamToCam(const std::string& path, CameraCalibration* calibration,
+                    const std::string& id = "02");
+// The camera's rectified optical frame (its own centre, axes as its rectified image) from its
+// frame: x_rectified = R_rect_00·x + t, where P_rect = K·[I | t] places the camera's centre
+// (KITTI: image_03's 0.54 m baseline to image_02 is in P_rect_03's last column).
+Rigid3d RectifiedFromCamera(const CameraCalibration& calibration);
 
 // calib_velo_to_cam.txt: R (9) and T (3) of T_camera_lidar (LiDAR to unrectified camera 0); R
 // is replaced by the nearest rotation.

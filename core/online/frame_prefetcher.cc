@@ -18,8 +18,7 @@ void FramePrefetcher::Start(int index) {
   pending_ = std::async(std::launch::async, [source = source_, index]() {
     Loaded loaded;
     loaded.index = index;
-    loaded.frame = std::make_shared<CalibrationFrame>();
-    loaded.status = source->Load(static_cast<size_t>(index), loaded.frame.get());
+    source->LoadCameras(static_cast<size_t>(index), &loaded.cameras);
     return loaded;
   });
 }

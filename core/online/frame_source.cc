@@ -59,8 +59,8 @@ ImageFeatureOptions FrameSourceOptions::ImageOptions() const {
 Eigen::Vector2d CameraAzimuthWindowDeg(const CameraCalibration& camera, int image_width,
                                        int image_height, const Rigid3d& T_camera_lidar,
                                        double margin_deg) {
-  const double fx = camera.P_rect_02(0, 0), fy = camera.P_rect_02(1, 1);
-  const double cx = camera.P_rect_02(0, 2), cy = camera.P_rect_02(1, 2);
+  const double fx = camera.P_rect(0, 0), fy = camera.P_rect(1, 1);
+  const double cx = camera.P_rect(0, 2), cy = camera.P_rect(1, 2);
   // Rectified camera ray -> LiDAR direction.
   const Eigen::Matrix3d R_lidar_rect =
       T_camera_lidar.linear().transpose() * camera.R_rect_00.transpose();
@@ -82,37 +82,88 @@ Eigen::Vector2d CameraAzimuthWindowDeg(const CameraCalibration& camera, int imag
   return Eigen::Vector2d(center * 180.0 / M_PI, half_deg);
 }
 
-Status DriveFrameSource::Create(const Drive* drive, const FrameSourceOptions& options,
-                                std::unique_ptr<DriveFrameSource>* source) {
-  STCALIB_RETURN_IF_ERROR(options.Validate());
-  std::unique_ptr<DriveFrameSource> s(new DriveFrameSource(drive, options));
-  if (options.view_margin_deg >= 0 && drive->camera.image_width > 0 &&
-      drive->camera.image_height > 0 && drive->camera.P_rect_02(0, 0) > 0 &&
-      drive->camera.P_rect_02(1, 1) > 0) {
-    const Eigen::Vector2d window = CameraAzimuthWindowDeg(
-        drive->camera, drive->camera.image_width, drive->camera.image_height,
-        options.view_T_camera_lidar.value_or(drive->T_camera_lidar), options.view_margin_deg);
-    s->options_.lidar.dynamic.roi_center_azimuth_deg = window.x();
-    s->options_.lidar.dynamic.roi_half_angle_deg = window.y();
+Eigen::Vector2d AzimuthWindowUnionDeg(const std::vector<Eigen::Vector2d>& windows) {
+  if (windows.empty()) return Eigen::Vector2d::Zero();
+  if (windows.size() == 1) return windows.front();
+  constexpr int kBins = 720;  // 0.5° each, bin b covering [−180 + b/2, −180 + (b+1)/2)
+  std::vector<bool> covered(kBins, false);
+  for (const Eigen::Vector2d& w : windows) {
+    if (w.y() <= 0) return Eigen::Vector2d::Zero();
+    const int from = static_cast<int>(std::floor(2 * (w.x() - w.y() + 180)));
+    const int to = static_cast<int>(std::ceil(2 * (w.x() + w.y() + 180)));
+    for (int b = from; b < to; ++b) covered[((b % kBins) + kBins) % kBins] = true;
   }
-  STCALIB_RETURN_IF_ERROR(DriveMotion::CreateForDrive(*drive, &s->motion_));
+  // The longest run of uncovered bins, around the circle: the window is its complement.
+  int best_start = -1, best_length = 0;
+  for (int start = 0; start < kBins; ++start) {
+    if (covered[start] || !covered[(start + kBins - 1) % kBins]) continue;
+    int length = 0;
+    while (length < kBins && !covered[(start + length) % kBins]) ++length;
+    if (length > best_length) best_length = length, best_start = start;
+  }
+  if (best_length == 0) return Eigen::Vector2d::Zero();
+  const double gap_centre_deg = -180 + 0.5 * (best_start + 0.5 * best_length);
+  const double half_deg = 0.5 * (360 - 0.5 * best_length);
+  return Eigen::Vector2d(std::remainder(gap_centre_deg + 180, 360.0), half_deg);
+}
+
+Status DriveFrameSource::Create(const std::vector<const Drive*>& cameras,
+                                const FrameSourceOptions& options,
+                                std::unique_ptr<DriveFrameSource>* source) {
+  CHECK(!cameras.empty());
+  STCALIB_RETURN_IF_ERROR(options.Validate());
+  const Drive& first = *cameras.front();
+  for (const Drive* camera : cameras) {
+    if (camera->frame_names != first.frame_names ||
+        camera->lidar_stamps_ns != first.lidar_stamps_ns) {
+      return Status::Error(camera->drive_dir + ": camera " + camera->camera_name +
+                           ": its frames or LiDAR stamps differ from camera " + first.camera_name +
+                           "'s (" + std::to_string(camera->NumFrames()) + " and " +
+                           std::to_string(first.NumFrames()) +
+                           " frames): the cameras must be of one drive");
+    }
+  }
+  std::unique_ptr<DriveFrameSource> s(new DriveFrameSource(cameras, options));
+  if (options.view_margin_deg >= 0) {
+    std::vector<Eigen::Vector2d> windows;
+    bool known = true;
+    for (const Drive* drive : cameras) {
+      known = known && drive->camera.image_width > 0 && drive->camera.image_height > 0 &&
+              drive->camera.P_rect(0, 0) > 0 && drive->camera.P_rect(1, 1) > 0;
+      if (!known) break;
+      // The view of camera k ≠ 0 as the start places the first one: the rig's relative mount.
+      const Rigid3d T_camera_first = drive->T_camera_lidar * first.T_camera_lidar.inverse();
+      windows.push_back(CameraAzimuthWindowDeg(
+          drive->camera, drive->camera.image_width, drive->camera.image_height,
+          T_camera_first * options.view_T_camera_lidar.value_or(first.T_camera_lidar),
+          options.view_margin_deg));
+    }
+    if (known) {
+      const Eigen::Vector2d window = AzimuthWindowUnionDeg(windows);
+      s->options_.lidar.dynamic.roi_center_azimuth_deg = window.x();
+      s->options_.lidar.dynamic.roi_half_angle_deg = window.y();
+    }
+  }
+  STCALIB_RETURN_IF_ERROR(DriveMotion::CreateForDrive(first, &s->motion_));
   // A sequential pass needs the local map's sweeps and the dynamic filter's long-baseline
   // reference, which the cache's least capacity holds: no more (each sweep kept costs ~4 MB).
-  s->cache_ = std::make_unique<SweepCache>(*drive, s->motion_, s->options_.lidar, /*capacity=*/0);
+  s->cache_ = std::make_unique<SweepCache>(first, s->motion_, s->options_.lidar, /*capacity=*/0);
   s->cache_->ReleaseCaptureFieldsOnceFinished();  // Load reads local maps only
   *source = std::move(s);
   return Status::Ok();
 }
 
-Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
-  STCALIB_RETURN_IF_ERROR(drive_->CheckFrame(frame));
+Status DriveFrameSource::LoadImageAndMotion(size_t camera, size_t frame,
+                                            CalibrationFrame* out) const {
+  const Drive& drive = *drives_[camera];
+  STCALIB_RETURN_IF_ERROR(drive.CheckFrame(frame));
   *out = CalibrationFrame();
-  const double camera_s = motion_.Seconds(drive_->camera_stamps_ns[frame]);
+  const double camera_s = motion_.Seconds(drive.camera_stamps_ns[frame]);
   const double oxts_gap_s = motion_.GapAround(camera_s);
   if (oxts_gap_s > options_.max_oxts_gap_s) {
     const bool oxts = motion_.source() == DriveMotion::Source::kOxts;
     const bool odometry = motion_.source() == DriveMotion::Source::kOdometry;
-    return Status::Error(drive_->drive_dir +
+    return Status::Error(drive.drive_dir +
                          (oxts       ? "/oxts"
                           : odometry ? " (odometry)"
                                      : "/velodyne_points") +
@@ -122,8 +173,8 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   }
   out->index = static_cast<int>(frame);
   cv::Mat image;
-  STCALIB_RETURN_IF_ERROR(drive_->LoadImage(frame, &image));
-  out->camera = MakeCameraModel(drive_->camera, image.cols, image.rows);
+  STCALIB_RETURN_IF_ERROR(drive.LoadImage(frame, &image));
+  out->camera = MakeCameraModel(drive.camera, image.cols, image.rows);
   out->image = ExtractImageFeatures(image, options_.ImageOptions());
   for (int kind = 0; kind < 2; ++kind) {
     const bool oriented = options_.oriented_maps && !out->image.empty();
@@ -154,16 +205,38 @@ Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
   out->score_maps_bandpass = options_.suppress_texture && options_.bandpass_score;
   ReleaseMapsNotRead(options_.ImageOptions().basin_px, out);
 
-  LidarEdges map;
-  LocalMapStats stats;
-  STCALIB_RETURN_IF_ERROR(cache_->LocalMap(frame, options_.local_map, &map, &stats));
-  out->TakePoints(std::move(map));
-
-  const double lidar_s = motion_.Seconds(drive_->lidar_stamps_ns[frame]);
+  const double lidar_s = motion_.Seconds(drive.lidar_stamps_ns[frame]);
   out->e0_s = lidar_s - camera_s;
   out->camera_time_s = camera_s;
   out->twist = TwistFromPoses(motion_.PoseFunction(), camera_s);
   return Status::Ok();
+}
+
+Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
+  STCALIB_RETURN_IF_ERROR(LoadImageAndMotion(0, frame, out));
+  LidarEdges map;
+  LocalMapStats stats;
+  STCALIB_RETURN_IF_ERROR(cache_->LocalMap(frame, options_.local_map, &map, &stats));
+  out->TakePoints(std::move(map));
+  return Status::Ok();
+}
+
+void DriveFrameSource::LoadCameras(size_t frame, std::vector<CameraFrameLoad>* out) {
+  out->assign(drives_.size(), CameraFrameLoad());
+  for (size_t k = 0; k < drives_.size(); ++k) {
+    (*out)[k].frame = std::make_shared<CalibrationFrame>();
+    (*out)[k].status = LoadImageAndMotion(k, frame, (*out)[k].frame.get());
+  }
+  LidarEdges map;
+  LocalMapStats stats;
+  const Status lidar = cache_->LocalMap(frame, options_.local_map, &map, &stats);
+  // Every camera but the last copies the map's points; the last takes them.
+  for (size_t k = 0; k < drives_.size(); ++k) {
+    CameraFrameLoad& load = (*out)[k];
+    if (load.status.ok() && !lidar.ok()) load.status = lidar;
+    if (!load.status.ok()) continue;
+    load.frame->TakePoints(k + 1 == drives_.size() ? std::move(map) : LidarEdges(map));
+  }
 }
 
 }  // namespace stcalib

@@ -2,6 +2,7 @@
 
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "core/features/image_features.h"
 #include "core/features/lidar_frame.h"
@@ -57,22 +58,49 @@ Eigen::Vector2d CameraAzimuthWindowDeg(const CameraCalibration& camera, int imag
                                        int image_height, const Rigid3d& T_camera_lidar,
                                        double margin_deg);
 
+// The smallest azimuth window [centre, half angle] in degrees that holds every window of
+// `windows` (CameraAzimuthWindowDeg's), to 0.5°; a half angle of 0 (the whole sweep) when one of
+// them is the whole sweep or together they leave no gap.
+Eigen::Vector2d AzimuthWindowUnionDeg(const std::vector<Eigen::Vector2d>& windows);
+
+// One camera's frame, as DriveFrameSource::LoadCameras returns it.
+struct CameraFrameLoad {
+  Status status = Status::Ok();  ///< a failed frame comes with its error
+  std::shared_ptr<CalibrationFrame> frame;
+};
+
 class DriveFrameSource {
  public:
   // The motion model comes from the drive's oxts, or, without oxts/ or without
   // calib_imu_to_velo.txt, from registering consecutive sweeps (constant velocity); errors say
   // why neither works.
   static Status Create(const Drive* drive, const FrameSourceOptions& options,
+                       std::unique_ptr<DriveFrameSource>* source) {
+    return Create(std::vector<const Drive*>{drive}, options, source);
+  }
+  // Several cameras of one drive (one Drive each, the same LiDAR and frames; the first's LiDAR
+  // and motion are read): each frame's sweeps, LiDAR features, local map and dynamic filter are
+  // computed once and shared by every camera. The dynamic filter judges the union of the
+  // cameras' views. Errors name a camera whose frames or LiDAR stamps differ from the first's.
+  static Status Create(const std::vector<const Drive*>& cameras, const FrameSourceOptions& options,
                        std::unique_ptr<DriveFrameSource>* source);
+  // Frame `frame` of the first camera.
   Status Load(size_t frame, CalibrationFrame* out);
+  // Frame `frame` of every camera, in Create's order. A failed image fails its camera's entry
+  // only; a failed sweep or motion fails every entry.
+  void LoadCameras(size_t frame, std::vector<CameraFrameLoad>* out);
+  size_t cameras() const { return drives_.size(); }
   const DriveMotion& motion() const { return motion_; }
   // The azimuth window the dynamic filter judges (roi_center_azimuth_deg, roi_half_angle_deg).
   const DynamicFilterOptions& dynamic_options() const { return options_.lidar.dynamic; }
 
  private:
-  DriveFrameSource(const Drive* drive, const FrameSourceOptions& options)
-      : drive_(drive), options_(options) {}
-  const Drive* drive_;
+  DriveFrameSource(std::vector<const Drive*> drives, const FrameSourceOptions& options)
+      : drives_(std::move(drives)), drive_(drives_.front()), options_(options) {}
+  // The camera's image, maps, stamps and motion (no points); `camera` indexes drives_.
+  Status LoadImageAndMotion(size_t camera, size_t frame, CalibrationFrame* out) const;
+  std::vector<const Drive*> drives_;
+  const Drive* drive_;  // the first camera's, whose LiDAR and motion every camera shares
   FrameSourceOptions options_;
   DriveMotion motion_;
   std::unique_ptr<SweepCache> cache_;

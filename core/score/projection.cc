@@ -5,7 +5,7 @@ namespace stcalib {
 CameraModel MakeCameraModel(const CameraCalibration& calibration, int width, int height) {
   CameraModel camera;
   camera.R_rect_00 = calibration.R_rect_00;
-  camera.P_rect_02 = calibration.P_rect_02;
+  camera.P_rect = calibration.P_rect;
   camera.width = width;
   camera.height = height;
   return camera;

@@ -62,12 +62,12 @@ struct FrameProjection {
 };
 FrameProjection ProjectionOf(const CalibrationFrame& cf, const Eigen::Matrix3d& R,
                              const Eigen::Vector3d& t, const Rigid3d& Tv) {
-  const Eigen::Matrix3d KR = cf.camera.P_rect_02.leftCols<3>() * cf.camera.R_rect_00;
+  const Eigen::Matrix3d KR = cf.camera.P_rect.leftCols<3>() * cf.camera.R_rect_00;
   const Eigen::Matrix3d R_total = R * Tv.linear();
   const Eigen::Vector3d t_total = R * Tv.translation() + t;
   FrameProjection p;
   p.M = KR * R_total;
-  p.b = KR * t_total + cf.camera.P_rect_02.col(3);
+  p.b = KR * t_total + cf.camera.P_rect.col(3);
   p.depth_row = (cf.camera.R_rect_00.row(2) * R_total).transpose();
   p.depth_offset = cf.camera.R_rect_00.row(2).dot(t_total);
   return p;

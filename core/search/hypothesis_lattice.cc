@@ -191,8 +191,8 @@ void ScoreFrameOnLattice(const CalibrationFrame& frame, const HypothesisLattice&
     weight[k] = static_cast<float>(k < num_vertical ? 1.0 - horizontal_weight : horizontal_weight);
   }
   const CameraModel& camera = frame.camera;
-  const Eigen::Matrix3d M = camera.P_rect_02.leftCols<3>() * camera.R_rect_00;
-  const Eigen::Vector3d p4 = camera.P_rect_02.col(3);
+  const Eigen::Matrix3d M = camera.P_rect.leftCols<3>() * camera.R_rect_00;
+  const Eigen::Vector3d p4 = camera.P_rect.col(3);
   const CalibrationState& centre = lattice.centre();
   // Per translation: b = M·(t_centre + Δt) + p4; the depth row of M·R_rect is that of P's third
   // row (rectified z plus P's small offset), so h_z ≥ min_depth stands in for the depth test.

@@ -141,10 +141,10 @@ SimulatedSweep SimulateLidarSweep(const Scene& scene, const SimTrajectory& traje
 cv::Mat RenderCameraImage(const Scene& scene, const SimTrajectory& trajectory, const CameraRig& rig,
                           double t_s, std::mt19937_64* rng) {
   const Rigid3d T_world_camera = trajectory.T_world_imu(t_s) * rig.T_imu_camera;
-  const Eigen::Matrix3d K = rig.P_rect_02.leftCols<3>();
+  const Eigen::Matrix3d K = rig.P_rect.leftCols<3>();
   const Eigen::Matrix3d K_inv = K.inverse();
   // Rectified camera 2 centre: P = K [I | K⁻¹ p4], so c_rect = −K⁻¹ p4.
-  const Eigen::Vector3d c_rect = -K_inv * rig.P_rect_02.col(3);
+  const Eigen::Vector3d c_rect = -K_inv * rig.P_rect.col(3);
   const Eigen::Matrix3d R_world_rect = T_world_camera.linear() * rig.R_rect_00.transpose();
   const Eigen::Vector3d origin = T_world_camera * (rig.R_rect_00.transpose() * c_rect);
   constexpr double kMaxRange = 400.0;

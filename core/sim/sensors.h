@@ -58,7 +58,7 @@ SimulatedSweep SimulateLidarSweep(const Scene& scene, const SimTrajectory& traje
 
 struct CameraRig {
   Eigen::Matrix3d R_rect_00 = Eigen::Matrix3d::Identity();
-  Eigen::Matrix<double, 3, 4> P_rect_02 = Eigen::Matrix<double, 3, 4>::Zero();
+  Eigen::Matrix<double, 3, 4> P_rect = Eigen::Matrix<double, 3, 4>::Zero();
   int width = 1242, height = 375;
   // The camera's mount tilted nose-down about its own centre, relative to KITTI's [deg].
   double nose_down_deg = 0.0;

@@ -27,7 +27,21 @@ enum Stream : uint64_t {
   kFrameCamera,
   kFrameOxts,
   kFrameClock,
-  kOxtsDrift
+  kOxtsDrift,
+  kRigCamera,  // per camera of the rig other than image_02
+};
+
+// The rig's other cameras, facing left, right and rear: their turn about the camera's y axis
+// (down) and their centre in image_02's frame (x right, y down, z forward) [m].
+struct RigMount {
+  double turn_deg;
+  Eigen::Vector3d centre_m;
+};
+constexpr int kMaxRigCameras = 4;
+const RigMount kRigMounts[kMaxRigCameras - 1] = {
+    {90.0, Eigen::Vector3d(-0.6, 0.0, -0.7)},
+    {-90.0, Eigen::Vector3d(0.6, 0.0, -0.7)},
+    {180.0, Eigen::Vector3d(0.0, 0.0, -1.6)},
 };
 
 std::mt19937_64 MakeRng(uint64_t seed, uint64_t stream, uint64_t frame = 0) {
@@ -126,22 +140,22 @@ CameraRig MakeCameraRig(SimCamera camera) {
     case SimCamera::kKitti:
       rig.R_rect_00 << 9.999239e-01, 9.837760e-03, -7.445048e-03, -9.869795e-03, 9.999421e-01,
           -4.278459e-03, 7.402527e-03, 4.351614e-03, 9.999631e-01;
-      rig.P_rect_02 << 7.215377e+02, 0.0, 6.095593e+02, 4.485728e+01, 0.0, 7.215377e+02,
-          1.728540e+02, 2.163791e-01, 0.0, 0.0, 1.0, 2.745884e-03;
+      rig.P_rect << 7.215377e+02, 0.0, 6.095593e+02, 4.485728e+01, 0.0, 7.215377e+02, 1.728540e+02,
+          2.163791e-01, 0.0, 0.0, 1.0, 2.745884e-03;
       rig.width = 1242;
       rig.height = 375;
       break;
     case SimCamera::kKitti1003:
       rig.R_rect_00 << 9.999454e-01, 7.259129e-03, -7.519551e-03, -7.292213e-03, 9.999638e-01,
           -4.381729e-03, 7.487471e-03, 4.436324e-03, 9.999621e-01;
-      rig.P_rect_02 << 7.188560e+02, 0.0, 6.071928e+02, 4.538225e+01, 0.0, 7.188560e+02,
-          1.852157e+02, -1.130887e-01, 0.0, 0.0, 1.0, 3.779761e-03;
+      rig.P_rect << 7.188560e+02, 0.0, 6.071928e+02, 4.538225e+01, 0.0, 7.188560e+02, 1.852157e+02,
+          -1.130887e-01, 0.0, 0.0, 1.0, 3.779761e-03;
       rig.width = 1241;
       rig.height = 376;
       break;
     case SimCamera::kHd720:
       rig.R_rect_00.setIdentity();
-      rig.P_rect_02 << 800.0, 0.0, 652.0, 0.0, 0.0, 800.0, 349.0, 0.0, 0.0, 0.0, 1.0, 0.0;
+      rig.P_rect << 800.0, 0.0, 652.0, 0.0, 0.0, 800.0, 349.0, 0.0, 0.0, 0.0, 1.0, 0.0;
       rig.width = 1280;
       rig.height = 720;
       rig.nose_down_deg = 3.0;
@@ -174,6 +188,10 @@ Status SimulatorOptions::Validate() const {
   }
   if (!(std::abs(distortion_k1) <= 1.0)) {
     return Status::Error("--distortion_k1 must be within ±1, got " + std::to_string(distortion_k1));
+  }
+  if (cameras < 1 || cameras > kMaxRigCameras) {
+    return Status::Error("--cameras must be between 1 and " + std::to_string(kMaxRigCameras) +
+                         ", got " + std::to_string(cameras));
   }
   if (!(std::abs(camera_delay_s) < 0.5 / lidar_hz)) {
     return Status::Error("camera delay must be under half a frame period");
@@ -228,6 +246,25 @@ Simulator::Simulator(const SimulatorOptions& options) : options_(options) {
   T_lidar_imu_ = NominalTLidarImu();
 
   rig_.T_imu_camera = T_lidar_imu_.inverse() * T_camera_lidar_.inverse();
+  for (int k = 1; k < options.cameras; ++k) {
+    std::mt19937_64 rng = MakeRng(seed, kRigCamera, k);
+    const RigMount& mount = kRigMounts[k - 1];
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(mount.turn_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).matrix();
+    Eigen::Vector3d wobble_deg, shift;  // one draw per statement: a fixed order
+    for (int axis = 0; axis < 3; ++axis) wobble_deg[axis] = angle(rng);
+    for (int axis = 0; axis < 3; ++axis) shift[axis] = offset(rng);
+    SimRigCamera camera;
+    camera.name = "image_0" + std::to_string(2 + k);
+    const Eigen::Matrix3d R = ExpSO3(wobble_deg * M_PI / 180.0) * turn;
+    camera.T_camera_reference = MakeRigid(R, -R * (mount.centre_m + shift));
+    camera.T_camera_lidar = camera.T_camera_reference * T_camera_lidar_;
+    std::uniform_real_distribution<double> clock(-0.02, 0.02);
+    camera.time_offset_s = options.time_offset_s + clock(rng);
+    camera.rig = rig_;
+    camera.rig.T_imu_camera = T_lidar_imu_.inverse() * camera.T_camera_lidar.inverse();
+    rig_cameras_.push_back(camera);
+  }
   std::uniform_real_distribution<double> sun_azimuth(0, 2 * M_PI), sun_elevation(0.6, 1.1);
   const double az = sun_azimuth(calib_rng), el = sun_elevation(calib_rng);
   rig_.sun_world =
@@ -253,16 +290,27 @@ KittiCalibFile Simulator::CameraCalibFile() const {
   file.SetText("calib_time", "simulated by stcalib");
   file.SetNumbers("S_rect_00", {static_cast<double>(rig_.width), static_cast<double>(rig_.height)});
   file.SetMatrix("R_rect_00", rig_.R_rect_00);
-  Eigen::Matrix<double, 3, 4> P_rect_00 = rig_.P_rect_02;
+  Eigen::Matrix<double, 3, 4> P_rect_00 = rig_.P_rect;
   P_rect_00.col(3).setZero();
   file.SetMatrix("P_rect_00", P_rect_00);
   file.SetNumbers("S_rect_02", {static_cast<double>(rig_.width), static_cast<double>(rig_.height)});
   file.SetMatrix("R_rect_02", Eigen::Matrix3d::Identity());
-  file.SetMatrix("P_rect_02", rig_.P_rect_02);
-  if (!rig_.distortion.empty()) {
-    file.SetText("distortion_model_02", "plumb_bob");
-    file.SetMatrix("K_02", rig_.P_rect_02.leftCols<3>());
-    file.SetNumbers("D_02", rig_.distortion);
+  file.SetMatrix("P_rect_02", rig_.P_rect);
+  auto set_distortion = [&](const std::string& id) {
+    if (rig_.distortion.empty()) return;
+    file.SetText("distortion_model_" + id, "plumb_bob");
+    file.SetMatrix("K_" + id, rig_.P_rect.leftCols<3>());
+    file.SetNumbers("D_" + id, rig_.distortion);
+  };
+  set_distortion("02");
+  for (const SimRigCamera& camera : rig_cameras_) {
+    const std::string id = camera.name.substr(6);
+    file.SetNumbers("S_rect_" + id,
+                    {static_cast<double>(rig_.width), static_cast<double>(rig_.height)});
+    file.SetMatrix("P_rect_" + id, rig_.P_rect);
+    file.SetMatrix("R_rig_" + id, camera.T_camera_reference.linear());
+    file.SetMatrix("T_rig_" + id, camera.T_camera_reference.translation());
+    set_distortion(id);
   }
   return file;
 }
@@ -304,6 +352,17 @@ SimulatedFrame Simulator::SimulateFrame(int frame) const {
   std::mt19937_64 camera_rng = MakeRng(options_.seed, kFrameCamera, frame);
   out.image_bgr = RenderCameraImage(*scene_, *trajectory_, rig_, out.camera_time_s, &camera_rng);
   out.oxts = SimulateOxts(frame);
+  // The other cameras expose with image_02; their stamps carry their δ's difference.
+  for (size_t k = 0; k < rig_cameras_.size(); ++k) {
+    const SimRigCamera& camera = rig_cameras_[k];
+    std::mt19937_64 rng =
+        MakeRng(options_.seed, kFrameCamera, static_cast<uint64_t>(frame) | ((k + 1) << 32));
+    out.rig_images_bgr.push_back(
+        RenderCameraImage(*scene_, *trajectory_, camera.rig, out.camera_time_s, &rng));
+    out.rig_camera_stamps_ns.push_back(
+        start_stamp_ns_ +
+        SecondsToNs(out.camera_time_s - options_.time_offset_s + camera.time_offset_s));
+  }
   return out;
 }
 
@@ -329,8 +388,11 @@ Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& o
   fs::remove_all(partial, ec);
   const std::string drive_name = date + "_drive_0001_sync";
   const fs::path drive = partial / drive_name;
-  for (const char* sub :
-       {"image_02/data", "velodyne_points/data", "velodyne_points/labels", "oxts/data"}) {
+  std::vector<std::string> folders = {"image_02/data", "velodyne_points/data",
+                                      "velodyne_points/labels", "oxts/data"};
+  for (const SimRigCamera& camera : simulator.rig_cameras())
+    folders.push_back(camera.name + "/data");
+  for (const std::string& sub : folders) {
     fs::create_directories(drive / sub, ec);
     if (ec) {
       fs::remove_all(partial, ec);
@@ -349,12 +411,19 @@ Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& o
     STCALIB_RETURN_IF_ERROR(WriteTextFile(d + "/oxts/dataformat.txt", DataFormatText()));
 
     std::vector<StampNs> camera, lidar, lidar_start, lidar_end, oxts;
+    const std::vector<SimRigCamera>& rig_cameras = simulator.rig_cameras();
+    std::vector<std::vector<StampNs>> rig_stamps(rig_cameras.size());
     nlohmann::json frames = nlohmann::json::array();
     for (int i = 0; i < options.frames; ++i) {
       const SimulatedFrame f = simulator.SimulateFrame(i);
       char name[16];
       std::snprintf(name, sizeof(name), "%010d", i);
       STCALIB_RETURN_IF_ERROR(WriteImage(d + "/image_02/data/" + name + ".png", f.image_bgr));
+      for (size_t k = 0; k < rig_cameras.size(); ++k) {
+        STCALIB_RETURN_IF_ERROR(WriteImage(d + "/" + rig_cameras[k].name + "/data/" + name + ".png",
+                                           f.rig_images_bgr[k]));
+        rig_stamps[k].push_back(f.rig_camera_stamps_ns[k]);
+      }
       STCALIB_RETURN_IF_ERROR(
           WriteVelodyneBin(d + "/velodyne_points/data/" + name + ".bin", f.sweep.scan));
       STCALIB_RETURN_IF_ERROR(
@@ -380,6 +449,15 @@ Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& o
       if (progress) progress(i + 1, options.frames);
     }
     STCALIB_RETURN_IF_ERROR(WriteTimestampsFile(d + "/image_02/timestamps.txt", camera));
+    nlohmann::json rig_truth = nlohmann::json::object();
+    for (size_t k = 0; k < rig_cameras.size(); ++k) {
+      STCALIB_RETURN_IF_ERROR(
+          WriteTimestampsFile(d + "/" + rig_cameras[k].name + "/timestamps.txt", rig_stamps[k]));
+      rig_truth[rig_cameras[k].name] = {
+          {"T_camera_lidar", ToJson(rig_cameras[k].T_camera_lidar)},
+          {"time_offset_s", rig_cameras[k].time_offset_s},
+          {"T_camera_image_02", ToJson(rig_cameras[k].T_camera_reference)}};
+    }
     STCALIB_RETURN_IF_ERROR(WriteTimestampsFile(d + "/velodyne_points/timestamps.txt", lidar));
     STCALIB_RETURN_IF_ERROR(
         WriteTimestampsFile(d + "/velodyne_points/timestamps_start.txt", lidar_start));
@@ -396,7 +474,7 @@ Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& o
                         {"lateral_m", o.lateral},
                         {"follows_ego", o.follows_ego}});
     }
-    const nlohmann::json truth = {
+    nlohmann::json truth = {
         {"generator", "stcalib simulate"},
         {"seed", options.seed},
         {"scene", SceneTypeName(options.scene)},
@@ -422,6 +500,7 @@ Status WriteSimulatedDrive(const SimulatorOptions& options, const std::string& o
         {"moving_objects", moving},
         {"per_frame", frames},
     };
+    if (!rig_truth.empty()) truth["cameras"] = rig_truth;
     return WriteTextFile((partial / "ground_truth.json").string(), truth.dump(2) + "\n");
   };
 

@@ -5,6 +5,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 #include "core/io/kitti_calib.h"
 #include "core/io/timestamps.h"
@@ -51,8 +52,23 @@ struct SimulatorOptions {
   // moves too little over δ for the time offset to be seen.
   double speed_mps = 0.0;
   NavigationErrorOptions oxts_error;  ///< the oxts packets' drift and noise
+  // Cameras of the rig (1 to 4): image_02 facing forward, then image_03 left, image_04 right and
+  // image_05 rear, each with its own mount and δ (SimRigCamera); all share image_02's intrinsics.
+  int cameras = 1;
 
   Status Validate() const;
+};
+
+// A camera of the rig other than image_02: where it is and how its clock is off.
+struct SimRigCamera {
+  std::string name;  ///< "image_03", …
+  // Its frame from image_02's (x = R·x_02 + T): turned to face its side, off by up to ±0.5° per
+  // axis and ±2 cm per seed; calib_cam_to_cam.txt's R_rig_0N and T_rig_0N.
+  Rigid3d T_camera_reference = Rigid3d::Identity();
+  Rigid3d T_camera_lidar = Rigid3d::Identity();  ///< its true extrinsic
+  // Its δ: image_02's plus up to ±20 ms. Its image stamps are the true capture time + δ_k − δ.
+  double time_offset_s = 0;
+  CameraRig rig;  ///< image_02's intrinsics at its own pose
 };
 
 // True times and written stamps of one frame.
@@ -68,6 +84,9 @@ struct SimulatedFrame : FrameTiming {
   SimulatedSweep sweep;
   cv::Mat image_bgr;
   OxtsPacket oxts;
+  // The rig's other cameras (Simulator::rig_cameras()'s order): their images and stamps.
+  std::vector<cv::Mat> rig_images_bgr;
+  std::vector<StampNs> rig_camera_stamps_ns;
 };
 
 // Ground truth and sensors of one simulated drive. Times are seconds from the drive's start
@@ -86,6 +105,7 @@ class Simulator {
   const Rigid3d& T_camera_lidar() const { return T_camera_lidar_; }
   const Rigid3d& T_lidar_imu() const { return T_lidar_imu_; }
   const CameraRig& camera_rig() const { return rig_; }
+  const std::vector<SimRigCamera>& rig_cameras() const { return rig_cameras_; }
   const LidarModel& lidar_model() const { return lidar_; }
   const SimTrajectory& trajectory() const { return *trajectory_; }
   const Scene& scene() const { return *scene_; }
@@ -93,7 +113,8 @@ class Simulator {
   StampNs start_stamp_ns() const { return start_stamp_ns_; }
   double SweepDuration() const { return 1.0 / options_.lidar_hz; }
   double LidarMidTime(int frame) const { return 0.05 + frame / options_.lidar_hz; }
-  // calib_cam_to_cam.txt contents (KITTI keys for image_02 and the rectification).
+  // calib_cam_to_cam.txt contents (KITTI keys for image_02 and the rectification; each other
+  // camera's P_rect_0N and S_rect_0N, and stcalib's R_rig_0N and T_rig_0N).
   KittiCalibFile CameraCalibFile() const;
   std::string DateFolder() const;  ///< e.g. "2026_01_02"
 
@@ -104,6 +125,7 @@ class Simulator {
   std::unique_ptr<Scene> scene_;
   Rigid3d T_camera_lidar_, T_lidar_imu_;
   CameraRig rig_;
+  std::vector<SimRigCamera> rig_cameras_;
   LidarModel lidar_;
   OxtsOrigin origin_;
   NavigationError oxts_error_;

@@ -4,11 +4,12 @@
 
 namespace stcalib {
 
-// The rectified colour camera image_02 (docs/method.md §1): a point p_camera in unrectified camera
-// 0 projects as u ~ P_rect_02 · [R_rect_00 · p_camera; 1].
+// A rectified camera (docs/method.md §1): a point p_camera of the camera's frame (KITTI: the
+// unrectified camera 0, which every KITTI camera projects from) projects as
+// u ~ P_rect · [R_rect_00 · p_camera; 1], P_rect the camera's own (KITTI: P_rect_02 of image_02).
 struct CameraModel {
   Eigen::Matrix3d R_rect_00 = Eigen::Matrix3d::Identity();
-  Eigen::Matrix<double, 3, 4> P_rect_02 = Eigen::Matrix<double, 3, 4>::Zero();
+  Eigen::Matrix<double, 3, 4> P_rect = Eigen::Matrix<double, 3, 4>::Zero();
   int width = 0;             ///< [px], read from the image or S_rect_02, never assumed
   int height = 0;            ///< [px]
   double min_depth_m = 0.5;  ///< points nearer than this (rectified z) are not projected [m]
@@ -39,7 +40,7 @@ struct CameraModel {
                Eigen::Matrix<double, 2, 3>* d_pixel_d_point) const {
     const Eigen::Vector3d p_rect = R_rect_00 * p_camera;
     if (p_rect.z() < min_depth_m) return false;
-    const Eigen::Vector3d h = P_rect_02.leftCols<3>() * p_rect + P_rect_02.col(3);
+    const Eigen::Vector3d h = P_rect.leftCols<3>() * p_rect + P_rect.col(3);
     if (h.z() <= 0) return false;
     const double inv_z = 1.0 / h.z();
     (*pixel) << h.x() * inv_z, h.y() * inv_z;
@@ -47,7 +48,7 @@ struct CameraModel {
     if (d_pixel_d_point != nullptr) {
       Eigen::Matrix<double, 2, 3> d_pixel_d_h;
       d_pixel_d_h << inv_z, 0, -(*pixel)(0) * inv_z, 0, inv_z, -(*pixel)(1) * inv_z;
-      *d_pixel_d_point = d_pixel_d_h * P_rect_02.leftCols<3>() * R_rect_00;
+      *d_pixel_d_point = d_pixel_d_h * P_rect.leftCols<3>() * R_rect_00;
     }
     return true;
   }

@@ -134,7 +134,7 @@ bool CheckReader(const std::string& name, const std::string& path) {
     CameraCalibration calibration;
     const Status status = ReadCamToCam(path, &calibration);
     CheckError(name, path, status);
-    if (status.ok() && (!calibration.P_rect_02.allFinite() || !calibration.R_rect_00.allFinite())) {
+    if (status.ok() && (!calibration.P_rect.allFinite() || !calibration.R_rect_00.allFinite())) {
       Broken(name, path, "non-finite camera calibration accepted");
     }
   } else if (name == "velo_to_cam" || name == "imu_to_velo") {
