@@ -20,6 +20,9 @@ struct CalibrateJob {
   // With more than one, each camera's outputs go to out_dir/<camera>/ and the rig's summary to
   // out_dir (WriteRigSummary).
   std::vector<std::string> cameras;
+  // With several cameras: also refine one LiDAR extrinsic for the rig over every claimed
+  // camera's frames, the rig's camera-to-camera transforms imposed (--rig_joint).
+  bool rig_joint = false;
   BagDriveOptions bag;  ///< a ROS 2 bag instead of the drive when bag.bag_dir is set
   double perturb_rot_deg = 0, perturb_trans_m = 0, perturb_time_s = 0;
   uint64_t seed = 1;
@@ -57,6 +60,11 @@ struct CalibrateOutcome {
   std::array<bool, kNumAxes> observable{};
   std::array<bool, kNumAxes> has_std{};    ///< result.json's `std`: false where it is null
   std::array<double, kNumAxes> std_dev{};  ///< [deg, m, s] (ReportUncertainty)
+  // The rig's joint refinement as this camera sees it (job.rig_joint; joint: the camera took
+  // part), with its error against the reference.
+  bool joint = false;
+  CalibrationState joint_estimate;
+  CalibrationError joint_error;
   std::vector<std::string> pictures;
   double mean_frame_ms = 0;
 };

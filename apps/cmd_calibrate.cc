@@ -87,6 +87,7 @@ CalibrateJob CalibrateJobFromFlags() {
   job.calib_dir = FLAGS_calib_dir;
   job.init_calib = FLAGS_init_calib;
   job.cameras = SplitCameras(FLAGS_cameras);
+  job.rig_joint = FLAGS_rig_joint;
   job.bag = BagOptionsFromFlags();
   job.out_dir = FLAGS_out;
   job.perturb_rot_deg = FLAGS_perturb_rot_deg;
@@ -177,18 +178,15 @@ namespace {
 // One camera's run: its drive, start, calibrator and what its frames did.
 struct CameraRun {
   Drive drive;
-  std::mt19937_64 rng;  ///< the start's signs, then the disturbance's
+  // The start's signs, then the disturbance's: the seed's own for every camera, so that each
+  // starts (and is disturbed) as far from its reference as a single-camera run would.
+  std::mt19937_64 rng;
   std::unique_ptr<OnlineCalibrator> calibrator;
   std::shared_ptr<const CalibrationFrame> last_frame;
   double frame_ms_sum = 0;
   int frames_used = 0;
   std::string out_dir;  ///< empty: nothing is written
 };
-
-// The rng of camera `k`'s start: camera 0's is the seed's own (a single-camera run's).
-std::mt19937_64 CameraRng(uint64_t seed, size_t k) {
-  return std::mt19937_64(k == 0 ? seed : seed ^ (0x9E3779B97F4A7C15ull * k));
-}
 
 // The camera's reference (simulated truth, else the drive's calibration) and start.
 Status StartCamera(const CalibrateJob& job, CameraRun* run, CalibrateOutcome* outcome) {
@@ -568,6 +566,45 @@ int FinishCamera(const CalibrateJob& job, int first, int last,
   return verdict_code();
 }
 
+// The rig's joint refinement (job.rig_joint) over the claimed cameras' latest frames, from the
+// first claimed camera's estimate; each camera's δ difference to it is held at the two estimates'.
+void RefineRig(const std::vector<CameraRun>& runs, std::vector<CalibrateOutcome>* outcomes) {
+  int anchor = -1;
+  std::vector<RigCameraFrames> cameras;
+  for (size_t k = 0; k < runs.size(); ++k) {
+    const CalibrateOutcome& outcome = (*outcomes)[k];
+    if (!outcome.converged) continue;
+    if (anchor < 0) anchor = static_cast<int>(k);
+    RigCameraFrames camera;
+    camera.frames = runs[k].calibrator->RecentFrames();
+    camera.T_camera_reference = outcome.T_camera_reference;
+    camera.time_offset_shift_s =
+        outcome.estimate.time_offset_s - (*outcomes)[anchor].estimate.time_offset_s;
+    cameras.push_back(camera);
+  }
+  if (anchor < 0) return;
+  const CalibrateOutcome& first = (*outcomes)[anchor];
+  CalibrationState start;
+  start.T_camera_lidar = first.T_camera_reference.inverse() * first.estimate.T_camera_lidar;
+  start.time_offset_s = first.estimate.time_offset_s;
+  const RefineResult joint =
+      RefineRigJointly(cameras, start, runs[anchor].calibrator->RefineOptionsInUse());
+  if (!joint.usable) {
+    LOG(WARNING) << "the rig's joint refinement failed: " << joint.message;
+    return;
+  }
+  size_t part = 0;
+  for (size_t k = 0; k < runs.size(); ++k) {
+    CalibrateOutcome& outcome = (*outcomes)[k];
+    if (!outcome.converged) continue;
+    outcome.joint = true;
+    outcome.joint_estimate.T_camera_lidar = outcome.T_camera_reference * joint.state.T_camera_lidar;
+    outcome.joint_estimate.time_offset_s =
+        joint.state.time_offset_s + cameras[part++].time_offset_shift_s;
+    outcome.joint_error = ComputeCalibrationError(outcome.joint_estimate, outcome.reference_state);
+  }
+}
+
 }  // namespace
 
 RigCamera ToRigCamera(const CalibrateOutcome& outcome) {
@@ -607,8 +644,16 @@ Status WriteRigSummary(const CalibrateJob& job, const std::vector<CalibrateOutco
          {"reference", outcome.reference},
          {outcome.has_truth ? "error" : "agreement_with_drive_calibration",
           ErrorJson(outcome.error)}});
+    if (outcome.joint) {  // beside the camera's own estimate: the rig's joint one
+      cameras.back()["joint"] = {
+          {"T_camera_lidar", MatrixJson(outcome.joint_estimate.T_camera_lidar)},
+          {"time_offset_s", outcome.joint_estimate.time_offset_s},
+          {outcome.has_truth ? "error" : "agreement_with_drive_calibration",
+           ErrorJson(outcome.joint_error)}};
+    }
   }
   nlohmann::json pairs = nlohmann::json::array();
+  bool rig_consistent = true;
   for (size_t a = 0; a < outcomes.size(); ++a) {
     for (size_t b = a + 1; b < outcomes.size(); ++b) {
       const CameraPairCheck pair =
@@ -618,6 +663,7 @@ Status WriteRigSummary(const CalibrateJob& job, const std::vector<CalibrateOutco
                               {"compared", pair.compared},
                               {"T_to_from_rig", MatrixJson(pair.T_to_from_rig)},
                               {"baseline_rig_m", pair.T_to_from_rig.translation().norm()}};
+      rig_consistent = rig_consistent && pair.consistent;
       if (pair.compared) {
         entry["T_to_from_estimated"] = MatrixJson(pair.T_to_from_estimated);
         entry["rotation_disagreement_deg"] = pair.rotation_deg;
@@ -625,6 +671,7 @@ Status WriteRigSummary(const CalibrateJob& job, const std::vector<CalibrateOutco
         entry["baseline_error_m"] = pair.baseline_m;
         entry["rotation_disagreement_std_deg"] = pair.rotation_std_deg;
         entry["translation_disagreement_std_m"] = pair.translation_std_m;
+        entry["consistent"] = pair.consistent;
       }
       pairs.push_back(entry);
     }
@@ -632,6 +679,7 @@ Status WriteRigSummary(const CalibrateJob& job, const std::vector<CalibrateOutco
   const nlohmann::json rig = {
       {"cameras", cameras},
       {"camera_pairs", pairs},
+      {"rig_consistent", rig_consistent},
       {"stcalib_version", StcalibVersion()},
       {"command", CommandLineText()},
       {"input", job.drive_dir},
@@ -676,7 +724,7 @@ int RunCalibrateJob(const CalibrateJob& job, std::vector<CalibrateOutcome>* outc
                                      std::to_string(drive.NumFrames()) + " frames)"));
   }
   for (size_t k = 0; k < n; ++k) {
-    runs[k].rng = CameraRng(job.seed, k);
+    runs[k].rng = std::mt19937_64(job.seed);
     status = StartCamera(job, &runs[k], &(*outcomes)[k]);
     if (!status.ok()) return ReportError(kCommand, status);
   }
@@ -788,9 +836,27 @@ int RunCalibrateJob(const CalibrateJob& job, std::vector<CalibrateOutcome>* outc
       code = camera_code;
     }
   }
+  if (n > 1 && job.rig_joint) RefineRig(runs, outcomes);
   if (n > 1 && !job.out_dir.empty()) {
     status = WriteRigSummary(job, *outcomes);
     if (!status.ok()) return ReportError(kCommand, status);
+  }
+  // Two claims that put the cameras where the rig does not: one of them is wrong.
+  for (size_t a = 0; a < n; ++a) {
+    for (size_t b = a + 1; b < n; ++b) {
+      const CameraPairCheck pair =
+          CompareCameraPair(ToRigCamera((*outcomes)[a]), ToRigCamera((*outcomes)[b]));
+      if (pair.compared && !pair.consistent) {
+        std::fprintf(stderr,
+                     "stcalib calibrate: the rig check fails: %s and %s claim camera-to-camera "
+                     "transforms %.3f deg and %.3f m from the rig's (their std allows %.3f deg "
+                     "and %.3f m): one of the two claims is wrong, or the rig moved\n",
+                     pair.from.c_str(), pair.to.c_str(), pair.rotation_deg, pair.translation_m,
+                     kRigRotationToleranceDeg + 3 * pair.rotation_std_deg,
+                     kRigTranslationToleranceM + 3 * pair.translation_std_m);
+        code = kExitFailure;
+      }
+    }
   }
   return code;
 }
@@ -870,6 +936,15 @@ int RunCalibrate() {
       std::printf("time_offset_s: %.9f\n", outcome.estimate.time_offset_s);
     }
   }
+  for (const CalibrateOutcome& outcome : outcomes) {
+    if (!outcome.joint) continue;
+    const CalibrationError& e = outcome.joint_error;
+    std::printf(
+        "%s: rig's joint estimate: %s rotation %.3f deg (roll %+.3f, pitch %+.3f, yaw %+.3f), "
+        "translation %.3f m, time offset %+.2f ms\n",
+        outcome.camera.c_str(), outcome.has_truth ? "error" : "agreement", e.rotation_deg,
+        e.roll_deg, e.pitch_deg, e.yaw_deg, e.translation_norm_m, 1000 * e.time_offset_s);
+  }
   // The rig: each pair of cameras as their estimates place them against the rig's own.
   for (size_t a = 0; a < outcomes.size(); ++a) {
     for (size_t b = a + 1; b < outcomes.size(); ++b) {
@@ -882,10 +957,10 @@ int RunCalibrate() {
       }
       std::printf(
           "%s to %s against the rig's calibration: rotation %.3f deg (expected spread %.3f), "
-          "translation %.3f m (expected spread %.3f), baseline %+.3f m of %.3f\n",
+          "translation %.3f m (expected spread %.3f), baseline %+.3f m of %.3f: %s\n",
           pair.from.c_str(), pair.to.c_str(), pair.rotation_deg, pair.rotation_std_deg,
           pair.translation_m, pair.translation_std_m, pair.baseline_m,
-          pair.T_to_from_rig.translation().norm());
+          pair.T_to_from_rig.translation().norm(), pair.consistent ? "consistent" : "INCONSISTENT");
     }
   }
   return code;

@@ -68,6 +68,10 @@ DEFINE_string(cameras, "",
               "separated (image_02,image_03); each gets OUT/<camera>/, the rig OUT/result.json "
               "(default: image_02 alone, outputs in OUT). simulate: the rig's number of cameras, "
               "1-4 (image_02 ahead, image_03 left, image_04 right, image_05 rear; default 1)");
+DEFINE_bool(rig_joint, false,
+            "calibrate with several --cameras: also refine one LiDAR extrinsic for the rig over "
+            "every claimed camera's frames, the rig's camera-to-camera transforms imposed "
+            "(result.json's `joint`, beside each camera's own estimate)");
 DEFINE_string(init_calib, "", "calibrate: initial calib_velo_to_cam.txt (default: the drive's)");
 DEFINE_double(perturb_rot_deg, 0.0,
               "calibrate: add this roll/pitch/yaw error (random signs) [deg]");

@@ -30,6 +30,7 @@ DECLARE_string(detector);
 DECLARE_double(min_segment_px);
 DECLARE_double(max_edge_density);
 DECLARE_string(cameras);
+DECLARE_bool(rig_joint);
 DECLARE_string(init_calib);
 DECLARE_string(init_uncertainty);
 DECLARE_double(perturb_rot_deg);

@@ -82,7 +82,8 @@ const std::vector<Subcommand>& Subcommands() {
         "odom_topic"}},
       {"calibrate",
        "(--drive=DRIVE_DIR [--calib_dir=DIR] | --bag=DIR --image_topic=T --cloud_topic=T "
-       "[--camera_info_topic=T] [--odom_topic=T | --imu_topic=T]) [--cameras=image_02,image_03] "
+       "[--camera_info_topic=T] [--odom_topic=T | --imu_topic=T]) [--cameras=image_02,image_03 "
+       "[--rig_joint]] "
        "[--init_calib=FILE] [--perturb_rot_deg=D] "
        "[--perturb_trans_m=M] [--perturb_time_s=S] [--init_uncertainty=DEG,M,S] [--seed=S] "
        "[--first_frame=I] [--num_frames=N] [--out=DIR] [--flagfile=configs/X.flags]",
@@ -95,6 +96,7 @@ const std::vector<Subcommand>& Subcommands() {
         "image_topic",
         "cloud_topic",
         "cameras",
+        "rig_joint",
         "init_calib",
         "out",
         "first_frame",

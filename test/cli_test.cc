@@ -238,8 +238,7 @@ TEST(Cli, CheckHoldsForKittiCalibrationAndCatchesOneDegreeOff) {
   EXPECT_EQ(good.exit_code, 0) << good.output;
   EXPECT_THAT(good.output, HasSubstr("holds: the rotation lies"));
   EXPECT_THAT(good.output, HasSubstr("30 frames in 30 blocks of 1"));
-  const nlohmann::json check =
-      nlohmann::json::parse(testing::ReadFile(tmp.path() + "/check.json"));
+  const nlohmann::json check = nlohmann::json::parse(testing::ReadFile(tmp.path() + "/check.json"));
   EXPECT_EQ(check["answer"], "holds");
   ASSERT_EQ(check["axes"].size(), 7u);
   EXPECT_EQ(check["axes"][0]["axis"], "roll_deg");
@@ -712,6 +711,89 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
   const int updates = ExpectUpdateTimingMatches(result, csv, 30);
   EXPECT_LT(updates, 30);
   EXPECT_GT(updates, 10);
+}
+
+// KITTI's two colour cameras in one pass over the LiDAR (drive 0020 of 2011_09_30): each camera
+// its own folder, claim and estimate, image_02's exactly as a run of it alone; the rig's
+// result.json compares the two estimates' camera-to-camera transform with calib_cam_to_cam's.
+TEST(Cli, CalibratesTwoKittiCamerasInOnePass) {
+  const std::string drive =
+      testing::SharedDataDir() + "/kitti-odometry/2011_09_30/2011_09_30_drive_0020_sync";
+  if (!std::filesystem::is_directory(drive + "/image_03")) {
+    GTEST_SKIP() << "shared KITTI data not found: " << drive << "/image_03";
+  }
+  testing::ScopedTempDir tmp;
+  const std::string flags = "calibrate --drive=" + drive + " --perturb_rot_deg=2 --seed=1 ";
+  const RunResult rig =
+      RunStcalib(flags + "--cameras=image_02,image_03 --rig_joint --out=" + tmp.path() + "/rig");
+  EXPECT_EQ(rig.exit_code, 0) << rig.output;
+  const RunResult alone = RunStcalib(flags + "--out=" + tmp.path() + "/alone");
+  EXPECT_EQ(alone.exit_code, 0) << alone.output;
+  const nlohmann::json left =
+      nlohmann::json::parse(testing::ReadFile(tmp.path() + "/rig/image_02/result.json"));
+  const nlohmann::json right =
+      nlohmann::json::parse(testing::ReadFile(tmp.path() + "/rig/image_03/result.json"));
+  const nlohmann::json single =
+      nlohmann::json::parse(testing::ReadFile(tmp.path() + "/alone/result.json"));
+  EXPECT_EQ(left["T_camera_lidar"], single["T_camera_lidar"]);
+  EXPECT_EQ(left["time_offset_s"], single["time_offset_s"]);
+  EXPECT_EQ(right["camera"], "image_03");
+  // Measured 0.242° (image_02) and 0.287° (image_03) from KITTI's calibration.
+  for (const nlohmann::json* camera : {&left, &right}) {
+    EXPECT_TRUE((*camera)["converged"].get<bool>()) << (*camera)["reason"];
+    EXPECT_LT((*camera)["agreement_with_drive_calibration"]["rotation_deg"].get<double>(), 0.35);
+  }
+  EXPECT_TRUE(std::filesystem::exists(tmp.path() + "/rig/image_03/calib_velo_to_cam.txt"));
+  EXPECT_TRUE(std::filesystem::exists(tmp.path() + "/rig/image_03/report.html"));
+  const nlohmann::json summary =
+      nlohmann::json::parse(testing::ReadFile(tmp.path() + "/rig/result.json"));
+  ASSERT_EQ(summary["cameras"].size(), 2u);
+  ASSERT_EQ(summary["camera_pairs"].size(), 1u);
+  const nlohmann::json& pair = summary["camera_pairs"][0];
+  EXPECT_EQ(pair["from"], "image_02");
+  EXPECT_EQ(pair["to"], "image_03");
+  EXPECT_NEAR(pair["baseline_rig_m"].get<double>(), 0.535, 0.005);  // P_rect_02 and P_rect_03
+  // Measured 0.264° and 3.4 cm (baseline +2.0 cm) with an expected spread of 0.16° and 15 cm.
+  EXPECT_LT(pair["rotation_disagreement_deg"].get<double>(), 0.4);
+  EXPECT_LT(pair["translation_disagreement_m"].get<double>(), 0.08);
+  EXPECT_TRUE(pair["consistent"].get<bool>());
+  EXPECT_TRUE(summary["rig_consistent"].get<bool>());
+  // The joint estimate is one extrinsic: the same for both cameras (KITTI's share camera 0's).
+  ASSERT_TRUE(summary["cameras"][0].contains("joint"));
+  EXPECT_EQ(summary["cameras"][0]["joint"]["T_camera_lidar"],
+            summary["cameras"][1]["joint"]["T_camera_lidar"]);
+  EXPECT_LT(summary["cameras"][0]["joint"]["agreement_with_drive_calibration"]["rotation_deg"]
+                .get<double>(),
+            0.35);
+  EXPECT_THAT(rig.output, HasSubstr("image_02 to image_03 against the rig's calibration"));
+}
+
+// A camera the drive does not have is an error naming it, not a run of the others; a name that
+// is not a camera folder, a camera named twice and --cameras with a bag are usage errors.
+TEST(Cli, CamerasMustBeTheDrivesOwn) {
+  const std::string drive =
+      testing::SharedDataDir() + "/kitti-odometry/2011_09_30/2011_09_30_drive_0020_sync";
+  if (!std::filesystem::is_directory(drive + "/image_03")) {
+    GTEST_SKIP() << "shared KITTI data not found: " << drive << "/image_03";
+  }
+  testing::ScopedTempDir tmp;
+  const std::string flags = "calibrate --drive=" + drive + " --out=" + tmp.path() + " ";
+  const RunResult missing = RunStcalib(flags + "--cameras=image_02,image_07");
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
+  EXPECT_THAT(missing.output, HasSubstr("camera image_07"));
+  EXPECT_FALSE(std::filesystem::exists(tmp.path() + "/image_02/result.json"));
+  const RunResult bad = RunStcalib(flags + "--cameras=left");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_THAT(bad.output, HasSubstr("'left' is not a KITTI camera folder"));
+  const RunResult twice = RunStcalib(flags + "--cameras=image_03,image_03");
+  EXPECT_EQ(twice.exit_code, 2) << twice.output;
+  EXPECT_THAT(twice.output, HasSubstr("names image_03 twice"));
+  const RunResult bag = RunStcalib("calibrate --bag=" + tmp.path() +
+                                   " --image_topic=a --cloud_topic=b --cameras=image_03");
+  EXPECT_EQ(bag.exit_code, 2) << bag.output;
+  const RunResult rig = RunStcalib("simulate --out=" + tmp.path() + "/s --cameras=5");
+  EXPECT_EQ(rig.exit_code, 2) << rig.output;
+  EXPECT_THAT(rig.output, HasSubstr("--cameras must be a number of cameras from 1 to 4"));
 }
 
 // The refined rotation (with the chosen candidate's translation and δ) is taken in place of the

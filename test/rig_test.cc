@@ -88,6 +88,15 @@ TEST(RigCheck, KittiColourCamerasAreTheBaselineApart) {
   pair = CompareCameraPair(a, b);
   EXPECT_NEAR(pair.rotation_deg, 0.2, 1e-6);
   EXPECT_NEAR(pair.translation_m, 0.03, 0.003);
+  EXPECT_TRUE(pair.consistent);
+  // 1.5° off with estimates that claim 0.05° each: one of them is wrong.
+  a.std_dev.fill(0.05);
+  b.std_dev.fill(0.05);
+  b.T_camera_lidar = PerturbTcameraLidar(right.T_camera_lidar, Eigen::Vector3d(0, 1.5, 0),
+                                         Eigen::Vector3d::Zero());
+  pair = CompareCameraPair(a, b);
+  EXPECT_NEAR(pair.rotation_deg, 1.5, 1e-6);
+  EXPECT_FALSE(pair.consistent);
   // Not both claimed: nothing compared.
   b.claimed = false;
   EXPECT_FALSE(CompareCameraPair(a, b).compared);
@@ -125,6 +134,34 @@ TEST(DriveFrameSource, TwoCamerasShareOneLidarPass) {
                        f2.score_maps[0].back()(cv::Rect(0, 0, 1000, 300)), cv::NORM_L1),
               0.0);
   }
+}
+
+// A frame of image_03 moved into a rig frame turned and shifted from its own projects a point of
+// the rig frame exactly where the camera's own model projects the point moved into its frame.
+TEST(RigCheck, InRigFrameProjectsThroughTheRigTransform) {
+  CalibrationFrame frame;
+  frame.camera.P_rect << 700, 0, 600, -330, 0, 700, 180, 2, 0, 0, 1, 0.003;
+  frame.camera.R_rect_00 = ExpSO3(Eigen::Vector3d(0.01, -0.02, 0.005));
+  frame.camera.width = 1226;
+  frame.camera.height = 370;
+  frame.e0_s = 0.01;
+  const Rigid3d T_camera_rig =
+      MakeRigid(ExpSO3(Eigen::Vector3d(0.1, 1.4, -0.05)), Eigen::Vector3d(0.3, -0.1, 0.8));
+  const CalibrationFrame moved = InRigFrame(frame, T_camera_rig, 0.02);
+  EXPECT_DOUBLE_EQ(moved.e0_s, 0.03);
+  int projected = 0;
+  for (const Eigen::Vector3d& p_rig :
+       {Eigen::Vector3d(8, 1, 3), Eigen::Vector3d(-2, 0.5, 12), Eigen::Vector3d(5, -1, -4)}) {
+    Eigen::Vector2d own, rig;
+    double depth_own, depth_rig;
+    const bool in_own = frame.camera.Project(T_camera_rig * p_rig, &own, &depth_own);
+    const bool in_rig = moved.camera.Project(p_rig, &rig, &depth_rig);
+    ASSERT_EQ(in_own, in_rig);
+    if (!in_own) continue;
+    ++projected;
+    EXPECT_LT((own - rig).norm(), 1e-9);
+  }
+  EXPECT_GE(projected, 1);
 }
 
 // A camera whose drive is not the first's (other frames) is refused by name.

@@ -38,7 +38,34 @@ CameraPairCheck CompareCameraPair(const RigCamera& from, const RigCamera& to) {
   check.baseline_m = t_estimated.norm() - t_rig.norm();
   check.rotation_std_deg = CombinedStd(from, to, 0, 3);
   check.translation_std_m = CombinedStd(from, to, 3, 6);
+  check.consistent = check.rotation_deg <= kRigRotationToleranceDeg + 3 * check.rotation_std_deg &&
+                     check.translation_m <= kRigTranslationToleranceM + 3 * check.translation_std_m;
   return check;
+}
+
+CalibrationFrame InRigFrame(const CalibrationFrame& frame, const Rigid3d& T_camera_reference,
+                            double time_offset_shift_s) {
+  CalibrationFrame out = frame;
+  // h = P₃ₓ₃·R_rect·(R·x + t) + p₄ = P₃ₓ₃·(R_rect·R)·x + (p₄ + P₃ₓ₃·R_rect·t).
+  CameraModel& camera = out.camera;
+  const Eigen::Matrix3d P = camera.P_rect.leftCols<3>();
+  camera.P_rect.col(3) += P * camera.R_rect_00 * T_camera_reference.translation();
+  camera.R_rect_00 = camera.R_rect_00 * T_camera_reference.linear();
+  out.e0_s += time_offset_shift_s;
+  return out;
+}
+
+RefineResult RefineRigJointly(const std::vector<RigCameraFrames>& cameras,
+                              const CalibrationState& start, const RefineOptions& options) {
+  std::vector<CalibrationFrame> frames;
+  for (const RigCameraFrames& camera : cameras) {
+    for (const auto& frame : camera.frames) {
+      frames.push_back(InRigFrame(*frame, camera.T_camera_reference, camera.time_offset_shift_s));
+    }
+  }
+  std::vector<const CalibrationFrame*> window;
+  for (const CalibrationFrame& frame : frames) window.push_back(&frame);
+  return Refine(window, start, start, start, options);
 }
 
 }  // namespace stcalib
