@@ -88,7 +88,12 @@ std::string CameraPrefix(const CalibrateJob& job, const CalibrateOutcome& outcom
 
 // The camera as the rig check reads it (core/online/rig_check.h).
 RigCamera ToRigCamera(const CalibrateOutcome& outcome);
+// Every pair of cameras (a before b in the job's order) as the rig check compares them.
+std::vector<CameraPairCheck> CompareRigPairs(const std::vector<CalibrateOutcome>& outcomes);
+// The estimate in calib_velo_to_cam.txt's frame (KITTI's camera 0): what the camera's file holds.
+Rigid3d EstimateInFileFrame(const CalibrateOutcome& outcome);
 // The rig's result.json in job.out_dir: every camera's claim, estimate and std, and the pairs.
-Status WriteRigSummary(const CalibrateJob& job, const std::vector<CalibrateOutcome>& outcomes);
+Status WriteRigSummary(const CalibrateJob& job, const std::vector<CalibrateOutcome>& outcomes,
+                       const std::vector<CameraPairCheck>& pairs);
 
 }  // namespace stcalib::cli

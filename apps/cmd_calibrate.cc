@@ -302,9 +302,7 @@ int FinishCamera(const CalibrateJob& job, int first, int last,
     }
     if (!held.empty()) held = "held at the start (not observable in this drive): " + held;
     // The file's frame is calib_velo_to_cam's own (KITTI's camera 0 for every KITTI camera).
-    status = WriteVeloToCam(
-        out + "/calib_velo_to_cam.txt",
-        drive.camera.T_camera_reference.inverse() * outcome->estimate.T_camera_lidar, held);
+    status = WriteVeloToCam(out + "/calib_velo_to_cam.txt", EstimateInFileFrame(*outcome), held);
     if (!status.ok()) return fail(status);
     status = WriteTimeOffset(out + "/" + kTimeOffsetFileName, outcome->estimate.time_offset_s,
                              time_held);
@@ -585,7 +583,7 @@ void RefineRig(const std::vector<CameraRun>& runs, std::vector<CalibrateOutcome>
   if (anchor < 0) return;
   const CalibrateOutcome& first = (*outcomes)[anchor];
   CalibrationState start;
-  start.T_camera_lidar = first.T_camera_reference.inverse() * first.estimate.T_camera_lidar;
+  start.T_camera_lidar = EstimateInFileFrame(first);
   start.time_offset_s = first.estimate.time_offset_s;
   const RefineResult joint =
       RefineRigJointly(cameras, start, runs[anchor].calibrator->RefineOptionsInUse());
@@ -619,7 +617,22 @@ RigCamera ToRigCamera(const CalibrateOutcome& outcome) {
   return camera;
 }
 
-Status WriteRigSummary(const CalibrateJob& job, const std::vector<CalibrateOutcome>& outcomes) {
+std::vector<CameraPairCheck> CompareRigPairs(const std::vector<CalibrateOutcome>& outcomes) {
+  std::vector<CameraPairCheck> pairs;
+  for (size_t a = 0; a < outcomes.size(); ++a) {
+    for (size_t b = a + 1; b < outcomes.size(); ++b) {
+      pairs.push_back(CompareCameraPair(ToRigCamera(outcomes[a]), ToRigCamera(outcomes[b])));
+    }
+  }
+  return pairs;
+}
+
+Rigid3d EstimateInFileFrame(const CalibrateOutcome& outcome) {
+  return outcome.T_camera_reference.inverse() * outcome.estimate.T_camera_lidar;
+}
+
+Status WriteRigSummary(const CalibrateJob& job, const std::vector<CalibrateOutcome>& outcomes,
+                       const std::vector<CameraPairCheck>& pair_checks) {
   nlohmann::json cameras = nlohmann::json::array();
   for (const CalibrateOutcome& outcome : outcomes) {
     const Eigen::Vector3d rpy_deg = MountRollPitchYawDeg(outcome.estimate.T_camera_lidar.linear());
@@ -654,27 +667,23 @@ Status WriteRigSummary(const CalibrateJob& job, const std::vector<CalibrateOutco
   }
   nlohmann::json pairs = nlohmann::json::array();
   bool rig_consistent = true;
-  for (size_t a = 0; a < outcomes.size(); ++a) {
-    for (size_t b = a + 1; b < outcomes.size(); ++b) {
-      const CameraPairCheck pair =
-          CompareCameraPair(ToRigCamera(outcomes[a]), ToRigCamera(outcomes[b]));
-      nlohmann::json entry = {{"from", pair.from},
-                              {"to", pair.to},
-                              {"compared", pair.compared},
-                              {"T_to_from_rig", MatrixJson(pair.T_to_from_rig)},
-                              {"baseline_rig_m", pair.T_to_from_rig.translation().norm()}};
-      rig_consistent = rig_consistent && pair.consistent;
-      if (pair.compared) {
-        entry["T_to_from_estimated"] = MatrixJson(pair.T_to_from_estimated);
-        entry["rotation_disagreement_deg"] = pair.rotation_deg;
-        entry["translation_disagreement_m"] = pair.translation_m;
-        entry["baseline_error_m"] = pair.baseline_m;
-        entry["rotation_disagreement_std_deg"] = pair.rotation_std_deg;
-        entry["translation_disagreement_std_m"] = pair.translation_std_m;
-        entry["consistent"] = pair.consistent;
-      }
-      pairs.push_back(entry);
+  for (const CameraPairCheck& pair : pair_checks) {
+    nlohmann::json entry = {{"from", pair.from},
+                            {"to", pair.to},
+                            {"compared", pair.compared},
+                            {"T_to_from_rig", MatrixJson(pair.T_to_from_rig)},
+                            {"baseline_rig_m", pair.T_to_from_rig.translation().norm()}};
+    rig_consistent = rig_consistent && pair.consistent;
+    if (pair.compared) {
+      entry["T_to_from_estimated"] = MatrixJson(pair.T_to_from_estimated);
+      entry["rotation_disagreement_deg"] = pair.rotation_deg;
+      entry["translation_disagreement_m"] = pair.translation_m;
+      entry["baseline_error_m"] = pair.baseline_m;
+      entry["rotation_disagreement_std_deg"] = pair.rotation_std_deg;
+      entry["translation_disagreement_std_m"] = pair.translation_std_m;
+      entry["consistent"] = pair.consistent;
     }
+    pairs.push_back(entry);
   }
   const nlohmann::json rig = {
       {"cameras", cameras},
@@ -837,25 +846,22 @@ int RunCalibrateJob(const CalibrateJob& job, std::vector<CalibrateOutcome>* outc
     }
   }
   if (n > 1 && job.rig_joint) RefineRig(runs, outcomes);
+  const std::vector<CameraPairCheck> pairs = CompareRigPairs(*outcomes);
   if (n > 1 && !job.out_dir.empty()) {
-    status = WriteRigSummary(job, *outcomes);
+    status = WriteRigSummary(job, *outcomes, pairs);
     if (!status.ok()) return ReportError(kCommand, status);
   }
   // Two claims that put the cameras where the rig does not: one of them is wrong.
-  for (size_t a = 0; a < n; ++a) {
-    for (size_t b = a + 1; b < n; ++b) {
-      const CameraPairCheck pair =
-          CompareCameraPair(ToRigCamera((*outcomes)[a]), ToRigCamera((*outcomes)[b]));
-      if (pair.compared && !pair.consistent) {
-        std::fprintf(stderr,
-                     "stcalib calibrate: the rig check fails: %s and %s claim camera-to-camera "
-                     "transforms %.3f deg and %.3f m from the rig's (their std allows %.3f deg "
-                     "and %.3f m): one of the two claims is wrong, or the rig moved\n",
-                     pair.from.c_str(), pair.to.c_str(), pair.rotation_deg, pair.translation_m,
-                     kRigRotationToleranceDeg + 3 * pair.rotation_std_deg,
-                     kRigTranslationToleranceM + 3 * pair.translation_std_m);
-        code = kExitFailure;
-      }
+  for (const CameraPairCheck& pair : pairs) {
+    if (pair.compared && !pair.consistent) {
+      std::fprintf(stderr,
+                   "stcalib calibrate: the rig check fails: %s and %s claim camera-to-camera "
+                   "transforms %.3f deg and %.3f m from the rig's (their std allows %.3f deg "
+                   "and %.3f m): one of the two claims is wrong, or the rig moved\n",
+                   pair.from.c_str(), pair.to.c_str(), pair.rotation_deg, pair.translation_m,
+                   kRigRotationToleranceDeg + 3 * pair.rotation_std_deg,
+                   kRigTranslationToleranceM + 3 * pair.translation_std_m);
+      code = kExitFailure;
     }
   }
   return code;
@@ -928,11 +934,9 @@ int RunCalibrate() {
                   outcome.mean_frame_ms,
                   (outcomes.size() > 1 ? FLAGS_out + "/" + outcome.camera : FLAGS_out).c_str());
     } else if (outcome.converged) {  // no --out: the estimate on stdout, nothing written
-      std::printf(
-          "%smean %.1f ms per frame; no --out, so the estimate is printed here:\n%s",
-          camera.c_str(), outcome.mean_frame_ms,
-          VeloToCamText(outcome.T_camera_reference.inverse() * outcome.estimate.T_camera_lidar)
-              .c_str());
+      std::printf("%smean %.1f ms per frame; no --out, so the estimate is printed here:\n%s",
+                  camera.c_str(), outcome.mean_frame_ms,
+                  VeloToCamText(EstimateInFileFrame(outcome)).c_str());
       std::printf("time_offset_s: %.9f\n", outcome.estimate.time_offset_s);
     }
   }
@@ -946,22 +950,18 @@ int RunCalibrate() {
         e.roll_deg, e.pitch_deg, e.yaw_deg, e.translation_norm_m, 1000 * e.time_offset_s);
   }
   // The rig: each pair of cameras as their estimates place them against the rig's own.
-  for (size_t a = 0; a < outcomes.size(); ++a) {
-    for (size_t b = a + 1; b < outcomes.size(); ++b) {
-      const CameraPairCheck pair =
-          CompareCameraPair(ToRigCamera(outcomes[a]), ToRigCamera(outcomes[b]));
-      if (!pair.compared) {
-        std::printf("%s to %s: not compared (not both claimed)\n", pair.from.c_str(),
-                    pair.to.c_str());
-        continue;
-      }
-      std::printf(
-          "%s to %s against the rig's calibration: rotation %.3f deg (expected spread %.3f), "
-          "translation %.3f m (expected spread %.3f), baseline %+.3f m of %.3f: %s\n",
-          pair.from.c_str(), pair.to.c_str(), pair.rotation_deg, pair.rotation_std_deg,
-          pair.translation_m, pair.translation_std_m, pair.baseline_m,
-          pair.T_to_from_rig.translation().norm(), pair.consistent ? "consistent" : "INCONSISTENT");
+  for (const CameraPairCheck& pair : CompareRigPairs(outcomes)) {
+    if (!pair.compared) {
+      std::printf("%s to %s: not compared (not both claimed)\n", pair.from.c_str(),
+                  pair.to.c_str());
+      continue;
     }
+    std::printf(
+        "%s to %s against the rig's calibration: rotation %.3f deg (expected spread %.3f), "
+        "translation %.3f m (expected spread %.3f), baseline %+.3f m of %.3f: %s\n",
+        pair.from.c_str(), pair.to.c_str(), pair.rotation_deg, pair.rotation_std_deg,
+        pair.translation_m, pair.translation_std_m, pair.baseline_m,
+        pair.T_to_from_rig.translation().norm(), pair.consistent ? "consistent" : "INCONSISTENT");
   }
   return code;
 }

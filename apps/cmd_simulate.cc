@@ -1,4 +1,5 @@
 // stcalib simulate: a KITTI-raw drive with exact ground truth.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -38,11 +39,12 @@ int RunSimulate() {
   if (!FLAGS_cameras.empty()) {  // simulate reads --cameras as the rig's number of cameras
     char* end = nullptr;
     const long cameras = std::strtol(FLAGS_cameras.c_str(), &end, 10);
-    if (*end != '\0' || cameras < 1 || cameras > 4) {
-      return UsageError("simulate", "--cameras must be a number of cameras from 1 to 4, got '" +
-                                        FLAGS_cameras + "'");
+    if (end == FLAGS_cameras.c_str() || *end != '\0') {
+      return UsageError("simulate",
+                        "--cameras must be a number of cameras, got '" + FLAGS_cameras + "'");
     }
-    options.cameras = static_cast<int>(cameras);
+    // Its range is SimulatorOptions::Validate's (below); clamped only to fit an int.
+    options.cameras = static_cast<int>(std::clamp(cameras, -1L, 1000L));
   }
   options.distortion_k1 = FLAGS_distortion_k1;
   options.speed_mps = FLAGS_speed_mps;

@@ -717,11 +717,8 @@ TEST(Cli, CalibratesKittiFromTwoDegrees) {
 // its own folder, claim and estimate, image_02's exactly as a run of it alone; the rig's
 // result.json compares the two estimates' camera-to-camera transform with calib_cam_to_cam's.
 TEST(Cli, CalibratesTwoKittiCamerasInOnePass) {
-  const std::string drive =
-      testing::SharedDataDir() + "/kitti-odometry/2011_09_30/2011_09_30_drive_0020_sync";
-  if (!std::filesystem::is_directory(drive + "/image_03")) {
-    GTEST_SKIP() << "shared KITTI data not found: " << drive << "/image_03";
-  }
+  STCALIB_REQUIRE_KITTI_STEREO();
+  const std::string drive = testing::KittiStereoDriveDir();
   testing::ScopedTempDir tmp;
   const std::string flags = "calibrate --drive=" + drive + " --perturb_rot_deg=2 --seed=1 ";
   const RunResult rig =
@@ -771,11 +768,8 @@ TEST(Cli, CalibratesTwoKittiCamerasInOnePass) {
 // A camera the drive does not have is an error naming it, not a run of the others; a name that
 // is not a camera folder, a camera named twice and --cameras with a bag are usage errors.
 TEST(Cli, CamerasMustBeTheDrivesOwn) {
-  const std::string drive =
-      testing::SharedDataDir() + "/kitti-odometry/2011_09_30/2011_09_30_drive_0020_sync";
-  if (!std::filesystem::is_directory(drive + "/image_03")) {
-    GTEST_SKIP() << "shared KITTI data not found: " << drive << "/image_03";
-  }
+  STCALIB_REQUIRE_KITTI_STEREO();
+  const std::string drive = testing::KittiStereoDriveDir();
   testing::ScopedTempDir tmp;
   const std::string flags = "calibrate --drive=" + drive + " --out=" + tmp.path() + " ";
   const RunResult missing = RunStcalib(flags + "--cameras=image_02,image_07");

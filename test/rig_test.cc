@@ -14,16 +14,6 @@
 namespace stcalib {
 namespace {
 
-std::string RightCameraDrive() {
-  return testing::SharedDataDir() + "/kitti-odometry/2011_09_30/2011_09_30_drive_0020_sync";
-}
-
-#define STCALIB_REQUIRE_RIGHT_CAMERA()                                    \
-  if (!std::filesystem::is_directory(RightCameraDrive() + "/image_03")) { \
-    GTEST_SKIP() << "shared KITTI data not found: " << RightCameraDrive() \
-                 << "/image_03 (../shared/data beside the repository)";   \
-  }
-
 TEST(AzimuthWindowUnion, HoldsEveryWindowAndNoMore) {
   // One window is itself.
   EXPECT_EQ(AzimuthWindowUnionDeg({Eigen::Vector2d(10, 40)}), Eigen::Vector2d(10, 40));
@@ -47,10 +37,10 @@ TEST(AzimuthWindowUnion, HoldsEveryWindowAndNoMore) {
 // KITTI's image_02 and image_03: one calibration file, two projections; the rig's transform
 // between their rectified frames is the 0.54 m baseline, parallel.
 TEST(RigCheck, KittiColourCamerasAreTheBaselineApart) {
-  STCALIB_REQUIRE_RIGHT_CAMERA();
+  STCALIB_REQUIRE_KITTI_STEREO();
   Drive left, right;
-  ASSERT_TRUE(OpenDrive(RightCameraDrive(), "", &left, "image_02").ok());
-  const Status open = OpenDrive(RightCameraDrive(), "", &right, "image_03");
+  ASSERT_TRUE(OpenDrive(testing::KittiStereoDriveDir(), "", &left, "image_02").ok());
+  const Status open = OpenDrive(testing::KittiStereoDriveDir(), "", &right, "image_03");
   ASSERT_TRUE(open.ok()) << open.message();
   Eigen::MatrixXd P3;
   ASSERT_TRUE(right.camera.file.GetMatrix("P_rect_03", 3, 4, &P3).ok());
@@ -58,7 +48,7 @@ TEST(RigCheck, KittiColourCamerasAreTheBaselineApart) {
   EXPECT_EQ(right.camera.image_width, 1226);
   // KITTI's cameras all project from camera 0's frame: one extrinsic.
   EXPECT_TRUE(right.T_camera_lidar.isApprox(left.T_camera_lidar, 1e-12));
-  EXPECT_EQ(right.ImagePath(4), RightCameraDrive() + "/image_03/data/0000000004.png");
+  EXPECT_EQ(right.ImagePath(4), testing::KittiStereoDriveDir() + "/image_03/data/0000000004.png");
 
   RigCamera a, b;
   a.name = "image_02";
@@ -105,10 +95,10 @@ TEST(RigCheck, KittiColourCamerasAreTheBaselineApart) {
 // One LiDAR pass for two cameras: each camera's frame carries the same local map and its own
 // image, stamps and motion; the first camera's is what a single-camera load gives.
 TEST(DriveFrameSource, TwoCamerasShareOneLidarPass) {
-  STCALIB_REQUIRE_RIGHT_CAMERA();
+  STCALIB_REQUIRE_KITTI_STEREO();
   Drive left, right;
-  ASSERT_TRUE(OpenDrive(RightCameraDrive(), "", &left, "image_02").ok());
-  ASSERT_TRUE(OpenDrive(RightCameraDrive(), "", &right, "image_03").ok());
+  ASSERT_TRUE(OpenDrive(testing::KittiStereoDriveDir(), "", &left, "image_02").ok());
+  ASSERT_TRUE(OpenDrive(testing::KittiStereoDriveDir(), "", &right, "image_03").ok());
   std::unique_ptr<DriveFrameSource> both, single;
   ASSERT_TRUE(DriveFrameSource::Create({&left, &right}, FrameSourceOptions(), &both).ok());
   ASSERT_TRUE(DriveFrameSource::Create(&left, FrameSourceOptions(), &single).ok());
@@ -166,10 +156,10 @@ TEST(RigCheck, InRigFrameProjectsThroughTheRigTransform) {
 
 // A camera whose drive is not the first's (other frames) is refused by name.
 TEST(DriveFrameSource, RefusesCamerasOfAnotherDrive) {
-  STCALIB_REQUIRE_RIGHT_CAMERA();
+  STCALIB_REQUIRE_KITTI_STEREO();
   STCALIB_REQUIRE_KITTI();
   Drive left, other;
-  ASSERT_TRUE(OpenDrive(RightCameraDrive(), "", &left, "image_02").ok());
+  ASSERT_TRUE(OpenDrive(testing::KittiStereoDriveDir(), "", &left, "image_02").ok());
   ASSERT_TRUE(OpenDrive(testing::KittiDriveDir(), "", &other, "image_02").ok());
   std::unique_ptr<DriveFrameSource> source;
   const Status status = DriveFrameSource::Create({&left, &other}, FrameSourceOptions(), &source);

@@ -27,6 +27,16 @@ inline bool HaveKitti() { return std::filesystem::is_directory(KittiDriveDir());
                  << " (clone with ../shared beside the repository)";                         \
   }
 
+// A shared drive with both KITTI colour cameras (image_02 and image_03): 0020 of 2011_09_30.
+inline std::string KittiStereoDriveDir() {
+  return SharedDataDir() + "/kitti-odometry/2011_09_30/2011_09_30_drive_0020_sync";
+}
+#define STCALIB_REQUIRE_KITTI_STEREO()                                                             \
+  if (!std::filesystem::is_directory(::stcalib::testing::KittiStereoDriveDir() + "/image_03")) {   \
+    GTEST_SKIP() << "shared KITTI data not found at " << ::stcalib::testing::KittiStereoDriveDir() \
+                 << "/image_03 (clone with ../shared beside the repository)";                      \
+  }
+
 // Opens the shared KITTI drive and, when `motion` is given, its motion; a failure names the
 // file and the problem. Call after STCALIB_REQUIRE_KITTI(): ASSERT_TRUE(OpenKittiDrive(&drive)).
 ::testing::AssertionResult OpenKittiDrive(Drive* drive, DriveMotion* motion = nullptr);

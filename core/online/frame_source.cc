@@ -213,11 +213,11 @@ Status DriveFrameSource::LoadImageAndMotion(size_t camera, size_t frame,
 }
 
 Status DriveFrameSource::Load(size_t frame, CalibrationFrame* out) {
-  STCALIB_RETURN_IF_ERROR(LoadImageAndMotion(0, frame, out));
-  LidarEdges map;
-  LocalMapStats stats;
-  STCALIB_RETURN_IF_ERROR(cache_->LocalMap(frame, options_.local_map, &map, &stats));
-  out->TakePoints(std::move(map));
+  CHECK_EQ(drives_.size(), 1u) << "Load reads a single-camera source; LoadCameras reads several";
+  std::vector<CameraFrameLoad> loads;
+  LoadCameras(frame, &loads);
+  if (!loads.front().status.ok()) return loads.front().status;
+  *out = std::move(*loads.front().frame);
   return Status::Ok();
 }
 

@@ -84,7 +84,7 @@ class DriveFrameSource {
   // cameras' views. Errors name a camera whose frames or LiDAR stamps differ from the first's.
   static Status Create(const std::vector<const Drive*>& cameras, const FrameSourceOptions& options,
                        std::unique_ptr<DriveFrameSource>* source);
-  // Frame `frame` of the first camera.
+  // Frame `frame` of a single-camera source (LoadCameras's one entry).
   Status Load(size_t frame, CalibrationFrame* out);
   // Frame `frame` of every camera, in Create's order. A failed image fails its camera's entry
   // only; a failed sweep or motion fails every entry.

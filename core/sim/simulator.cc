@@ -190,8 +190,8 @@ Status SimulatorOptions::Validate() const {
     return Status::Error("--distortion_k1 must be within ±1, got " + std::to_string(distortion_k1));
   }
   if (cameras < 1 || cameras > kMaxRigCameras) {
-    return Status::Error("--cameras must be between 1 and " + std::to_string(kMaxRigCameras) +
-                         ", got " + std::to_string(cameras));
+    return Status::Error("--cameras must be a number of cameras from 1 to " +
+                         std::to_string(kMaxRigCameras) + ", got " + std::to_string(cameras));
   }
   if (!(std::abs(camera_delay_s) < 0.5 / lidar_hz)) {
     return Status::Error("camera delay must be under half a frame period");
