@@ -707,11 +707,8 @@ int RunCalibrateJob(const CalibrateJob& job, std::vector<CalibrateOutcome>* outc
   if (!status.ok()) return UsageError(kCommand, status.message());
   const std::vector<std::string> camera_names =
       job.cameras.empty() ? std::vector<std::string>{"image_02"} : job.cameras;
-  if (!job.bag.bag_dir.empty() && camera_names.size() > 1) {
-    return UsageError(kCommand,
-                      "--cameras names KITTI camera folders of a --drive; a bag has one "
-                      "--image_topic");
-  }
+  CHECK(job.bag.bag_dir.empty() || job.cameras.empty())
+      << "CalibrateFlagsError refuses --cameras with --bag";
   const size_t n = camera_names.size();
   std::vector<CameraRun> runs(n);
   outcomes->assign(n, CalibrateOutcome());
